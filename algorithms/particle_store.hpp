@@ -1,0 +1,117 @@
+// The particle store: every per-particle field as its own array (structure of arrays), all owned
+// here, and one call that applies a permutation to every persistent field at once (the Cabana
+// habit: no per-solver "remember to sort my field" hooks).
+//
+// Layout: [0, moving_count) particles that move and are re-sorted every step (fluid, SBPs, IBPs,
+// GPs), then [moving_count, size) static boundary particles, sorted once at start-up. Particles
+// may change type at run time (melting turns an SBP into fluid): type is data, not position.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "algorithms/vec3.hpp"
+#include "backend/backend.hpp"
+
+MW_BACKEND_BEGIN
+
+// data[i] <- data[perm[i]] for i < perm.size(), through `gathered` (free function: nvcc does not
+// allow device lambdas inside private nested classes).
+template <class T>
+void permute_in_place(T* data, View<const std::uint32_t> perm, T* gathered) {
+    parallel_for("store_permute_gather", perm.size(), [=] MW_HD(std::size_t i) { gathered[i] = data[perm[i]]; });
+    parallel_for("store_permute_copy", perm.size(), [=] MW_HD(std::size_t i) { data[i] = gathered[i]; });
+}
+
+// Persistent fields survive from step to step and are permuted with the particles; scratch
+// fields are recomputed every step after the sort, so permuting them would waste bandwidth.
+enum class FieldLife { kPersistent, kScratch };
+
+class ParticleStore {
+    struct Field;
+    // Declared first: the registry must exist before the core fields below register in it.
+    std::vector<std::unique_ptr<Field>> fields_;
+    DeviceArray<unsigned char> scratch_;  // one gather buffer shared by all fields
+    std::size_t size_ = 0;
+    std::size_t moving_count_ = 0;
+
+   public:
+    ParticleStore()
+        : id(add<std::uint32_t>("id", FieldLife::kPersistent)),
+          position(add<Vec3>("position", FieldLife::kPersistent)),
+          velocity(add<Vec3>("velocity", FieldLife::kPersistent)),
+          type(add<std::uint8_t>("type", FieldLife::kPersistent)),
+          object(add<std::int32_t>("object", FieldLife::kPersistent)),
+          density(add<Real>("density", FieldLife::kPersistent)),
+          pressure(add<Real>("pressure", FieldLife::kPersistent)) {}
+
+    ParticleStore(const ParticleStore&) = delete;
+    ParticleStore& operator=(const ParticleStore&) = delete;
+
+    // Registers a new per-particle field (sized like the store). Later stages (coupling, LSM,
+    // melting) add their own fields this way; the reference stays valid for the store's life.
+    template <class T>
+    DeviceArray<T>& add(const char* name, FieldLife life) {
+        auto field = std::make_unique<TypedField<T>>(name, life);
+        field->array.resize(size_);
+        DeviceArray<T>& array = field->array;
+        fields_.push_back(std::move(field));
+        return array;
+    }
+
+    void resize(std::size_t count, std::size_t moving_count) {
+        size_ = count;
+        moving_count_ = moving_count;
+        for (auto& f : fields_) f->resize(count);
+    }
+    std::size_t size() const { return size_; }
+    std::size_t moving_count() const { return moving_count_; }
+    std::size_t static_count() const { return size_ - moving_count_; }
+
+    // Reorders particles [first, first + perm.size()): new slot i takes the particle that was at
+    // first + perm[i]. Persistent fields only.
+    void permute(View<const std::uint32_t> perm, std::size_t first) {
+        for (auto& f : fields_)
+            if (f->life == FieldLife::kPersistent) f->permute(perm, first, scratch_);
+    }
+
+    std::size_t bytes() const {
+        std::size_t total = scratch_.bytes();
+        for (const auto& f : fields_) total += f->bytes();
+        return total;
+    }
+
+    DeviceArray<std::uint32_t>& id;  // the particle's index in the scene's initial list
+    DeviceArray<Vec3>& position;
+    DeviceArray<Vec3>& velocity;
+    DeviceArray<std::uint8_t>& type;
+    DeviceArray<std::int32_t>& object;
+    DeviceArray<Real>& density;   // persistent: the last predicted density seeds viscosity
+    DeviceArray<Real>& pressure;  // persistent: warm-starts the next step's PCISPH
+
+   private:
+    struct Field {
+        Field(const char* field_name, FieldLife field_life) : name(field_name), life(field_life) {}
+        virtual ~Field() = default;
+        virtual void resize(std::size_t n) = 0;
+        virtual std::size_t bytes() const = 0;
+        virtual void permute(View<const std::uint32_t> perm, std::size_t first, DeviceArray<unsigned char>& scratch) = 0;
+        std::string name;
+        FieldLife life;
+    };
+    template <class T>
+    struct TypedField final : Field {
+        using Field::Field;
+        DeviceArray<T> array;
+        void resize(std::size_t n) override { array.resize(n); }
+        std::size_t bytes() const override { return array.bytes(); }
+        void permute(View<const std::uint32_t> perm, std::size_t first, DeviceArray<unsigned char>& scratch) override {
+            const std::size_t n = perm.size();
+            scratch.resize(n * sizeof(T));
+            permute_in_place(array.view().data() + first, perm, reinterpret_cast<T*>(scratch.view().data()));
+        }
+    };
+
+};
+
+MW_BACKEND_END

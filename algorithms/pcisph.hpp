@@ -1,0 +1,179 @@
+// PCISPH (Solenthaler & Pajarola 2009) with Akinci boundary particles, as in METHOD.md, written
+// once against the backend abstraction. Every stage is a gather: particle i reads its neighbours
+// and writes only itself, so results do not depend on thread scheduling.
+//
+// Pressure force: the symmetric form -m Σ_j (p_i/ρ_i² + p_j/ρ_j²) ∇W_ij, which is the form PCISPH's
+// δ is derived for. (The paper's Eq. 3 as printed, (p_i + p_j)/(2 ρ_i ρ_j), is half of it near ρ0
+// and would make δ twice too soft.) Boundary particles mirror the fluid pressure (Akinci 2012):
+// -ψ_b (p_i/ρ_i²) ∇W_ib with ψ_b = ρ0 V_b.
+#pragma once
+#include "algorithms/neighbor_grid.hpp"
+#include "algorithms/sph_kernels.hpp"
+
+MW_BACKEND_BEGIN
+
+struct FluidConstants {
+    SphKernel kernel;
+    Real support2 = 0;        // h²
+    Real rest_density = 0;    // ρ0
+    Real mass = 0;            // fluid particle mass
+    Real viscosity = 0;       // μ
+    Vec3 gravity{0, 0, 0};
+};
+
+struct DensityError {
+    double sum = 0;   // Σ max(ρ - ρ0, 0) / ρ0
+    Real max = 0;
+};
+struct DensityErrorOp {
+    MW_INLINE DensityError operator()(const DensityError& a, const DensityError& b) const {
+        return DensityError{a.sum + b.sum, a.max < b.max ? b.max : a.max};
+    }
+};
+
+// Akinci boundary volume V_b = 1 / Σ_k W(x_b - x_k) over boundary neighbours k (b included), for
+// particles [first, first + count). Static particles see static neighbours only (computed once);
+// moving solids see moving solids and static walls.
+inline void compute_boundary_volumes(GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
+                                     std::size_t count, bool moving, SphKernel kernel) {
+    const Real h2 = kernel.h * kernel.h;
+    parallel_for("boundary_volume", count, [=] MW_HD(std::size_t k) {
+        const std::size_t b = first + k;
+        const Vec3 xb = position[b];
+        Real sum = 0;
+        auto add = [&](std::uint32_t j) {
+            const Vec3 d = xb - position[j];
+            const Real r2 = norm2(d);
+            if (r2 < h2) sum += kernel.W(std::sqrt(r2));
+        };
+        grid.for_each_static(xb, add);
+        if (moving) grid.for_each_solid(xb, add);
+        volume[b] = sum > Real(0) ? Real(1) / sum : Real(0);
+    });
+}
+
+// Non-pressure acceleration of fluid: gravity plus viscosity (the paper's Eq. 4 with the
+// Müller viscosity Laplacian, which is never negative). Densities are the previous step's.
+inline void compute_viscosity_acceleration(GridView grid, std::size_t fluid_count, View<const Vec3> position,
+                                           View<const Vec3> velocity, View<const Real> density,
+                                           View<Vec3> acceleration, FluidConstants c) {
+    parallel_for("viscosity", fluid_count, [=] MW_HD(std::size_t i) {
+        const Vec3 xi = position[i], vi = velocity[i];
+        Vec3 sum{0, 0, 0};
+        grid.for_each_fluid(xi, [&](std::uint32_t j) {
+            const Vec3 d = xi - position[j];
+            const Real r2 = norm2(d);
+            if (r2 >= c.support2 || j == i) return;
+            sum += (c.kernel.laplacian_visc(std::sqrt(r2)) / density[j]) * (velocity[j] - vi);
+        });
+        acceleration[i] = c.gravity + (c.viscosity * c.mass / density[i]) * sum;
+    });
+}
+
+// x*_i = x_i + Δt (v_i + Δt (a_np + a_p)). Without a non-pressure field, a_np is gravity.
+// A null pressure_acc means no pressure acceleration yet.
+inline void predict_positions(std::size_t fluid_count, View<const Vec3> position, View<const Vec3> velocity,
+                              const Vec3* nonpressure, const Vec3* pressure_acc, View<Vec3> predicted, Vec3 gravity,
+                              Real dt) {
+    parallel_for("pcisph_predict", fluid_count, [=] MW_HD(std::size_t i) {
+        Vec3 a = nonpressure ? nonpressure[i] : gravity;
+        if (pressure_acc) a += pressure_acc[i];
+        predicted[i] = position[i] + dt * (velocity[i] + dt * a);
+    });
+}
+
+// Predicted density from fluid (at predicted positions) and boundary particles, then
+// p_i += δ (ρ*_i - ρ0), clamped at 0 (free-surface particle deficiency).
+inline void predict_density_and_pressure(GridView grid, std::size_t fluid_count, View<const Vec3> predicted,
+                                         View<const Vec3> position, View<const Real> boundary_volume,
+                                         View<Real> density, View<Real> pressure, FluidConstants c, Real delta) {
+    parallel_for("pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
+        const Vec3 xi = predicted[i];
+        Real fluid_sum = 0, boundary_sum = 0;
+        grid.for_each_fluid(position[i], [&](std::uint32_t j) {
+            const Real r2 = norm2(xi - predicted[j]);
+            if (r2 < c.support2) fluid_sum += c.kernel.W(std::sqrt(r2));
+        });
+        auto boundary = [&](std::uint32_t b) {
+            const Real r2 = norm2(xi - position[b]);
+            if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.W(std::sqrt(r2));
+        };
+        grid.for_each_static(position[i], boundary);
+        grid.for_each_solid(position[i], boundary);
+        const Real rho = c.mass * fluid_sum + c.rest_density * boundary_sum;
+        density[i] = rho;
+        const Real p = pressure[i] + delta * (rho - c.rest_density);
+        pressure[i] = p > Real(0) ? p : Real(0);
+    });
+}
+
+inline DensityError density_error(std::size_t fluid_count, View<const Real> density, Real rest_density) {
+    const Real inv_rest = Real(1) / rest_density;
+    return transform_reduce("pcisph_density_error", fluid_count, DensityError{}, DensityErrorOp{},
+                            [=] MW_HD(std::size_t i) {
+                                const Real e = (density[i] - rest_density) * inv_rest;
+                                const Real compression = e > Real(0) ? e : Real(0);
+                                return DensityError{double(compression), compression};
+                            });
+}
+
+// a_p,i = -m Σ_j (p_i/ρ_i² + p_j/ρ_j²) ∇W(x*_ij) - Σ_b ψ_b (p_i/ρ_i²) ∇W(x*_i - x_b).
+inline void pressure_acceleration(GridView grid, std::size_t fluid_count, View<const Vec3> predicted,
+                                  View<const Vec3> position, View<const Real> boundary_volume,
+                                  View<const Real> density, View<const Real> pressure, View<Vec3> pressure_acc,
+                                  FluidConstants c) {
+    parallel_for("pcisph_pressure_force", fluid_count, [=] MW_HD(std::size_t i) {
+        const Vec3 xi = predicted[i];
+        const Real pi_rho2 = pressure[i] / (density[i] * density[i]);
+        Vec3 fluid_sum{0, 0, 0}, boundary_sum{0, 0, 0};
+        grid.for_each_fluid(position[i], [&](std::uint32_t j) {
+            const Vec3 d = xi - predicted[j];
+            const Real r2 = norm2(d);
+            if (r2 >= c.support2 || j == i) return;
+            fluid_sum += (pi_rho2 + pressure[j] / (density[j] * density[j])) * c.kernel.grad_W(d, std::sqrt(r2));
+        });
+        auto boundary = [&](std::uint32_t b) {
+            const Vec3 d = xi - position[b];
+            const Real r2 = norm2(d);
+            if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.grad_W(d, std::sqrt(r2));
+        };
+        grid.for_each_static(position[i], boundary);
+        grid.for_each_solid(position[i], boundary);
+        pressure_acc[i] = -(c.mass * fluid_sum + (c.rest_density * pi_rho2) * boundary_sum);
+    });
+}
+
+// Symplectic Euler: v += Δt (a_np + a_p); x += Δt v.
+inline void integrate_fluid(std::size_t fluid_count, View<Vec3> position, View<Vec3> velocity, const Vec3* nonpressure,
+                            View<const Vec3> pressure_acc, Vec3 gravity, Real dt) {
+    parallel_for("integrate_fluid", fluid_count, [=] MW_HD(std::size_t i) {
+        const Vec3 a = (nonpressure ? nonpressure[i] : gravity) + pressure_acc[i];
+        const Vec3 v = velocity[i] + dt * a;
+        velocity[i] = v;
+        position[i] = position[i] + dt * v;
+    });
+}
+
+// Kinetic energy, largest speed and the first non-finite particle, in one pass.
+struct MotionSummary {
+    double kinetic_energy = 0;
+    Real max_speed2 = 0;
+    std::uint32_t first_bad = 0xffffffffu;
+};
+struct MotionSummaryOp {
+    MW_INLINE MotionSummary operator()(const MotionSummary& a, const MotionSummary& b) const {
+        return MotionSummary{a.kinetic_energy + b.kinetic_energy, a.max_speed2 < b.max_speed2 ? b.max_speed2 : a.max_speed2,
+                             a.first_bad < b.first_bad ? a.first_bad : b.first_bad};
+    }
+};
+inline MotionSummary summarize_motion(std::size_t count, View<const Vec3> position, View<const Vec3> velocity, Real mass) {
+    return transform_reduce("motion_summary", count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
+        const Vec3 v = velocity[i];
+        const Real v2 = norm2(v);
+        const bool finite = is_finite(v) && is_finite(position[i]);
+        return MotionSummary{finite ? 0.5 * double(mass) * double(v2) : 0.0, finite ? v2 : Real(0),
+                             finite ? 0xffffffffu : static_cast<std::uint32_t>(i)};
+    });
+}
+
+MW_BACKEND_END

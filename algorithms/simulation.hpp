@@ -1,0 +1,105 @@
+// The backend-neutral face of a simulation: what apps/, tests and benchmarks see. It holds plain
+// host data only (no backend types), so it can be included anywhere, CUDA or not.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "algorithms/particle_types.hpp"
+#include "algorithms/vec3.hpp"
+
+namespace mw {
+
+enum class TimeStepMode { kFixed, kCfl };
+enum class CellOrdering { kLinear, kZOrder };
+
+struct FluidParams {
+    Real rest_density = 1000;     // ρ0, kg/m³
+    Real spacing = 0.02;          // r0, m
+    Real support_radius = 0.04;   // h, m
+    Real viscosity = 0;           // μ, Pa·s (Eq. 4); 0 switches the viscosity stage off
+};
+
+struct SolverParams {
+    Real dt = 0.001;                         // s: the fixed step, or the largest step in CFL mode
+    TimeStepMode dt_mode = TimeStepMode::kFixed;
+    Real cfl_number = 0.4;                   // Δt ≤ cfl · r0 / v_max in CFL mode
+    Real dt_min = 1e-6;                      // CFL mode never goes below this
+    Real eta = 0.01;                         // PCISPH stops when the average density error < η
+    int min_iterations = 3;
+    int max_iterations = 100;
+    // Start each step's pressure from this fraction of the previous step's instead of zero (an
+    // addition to the original PCISPH; 0 is the original). The previous pressure also holds the
+    // one-off correction of its own step, so re-applying all of it overshoots.
+    Real warm_start = 0;
+};
+
+struct SimulationParams {
+    Vec3 domain_min{0, 0, 0};
+    Vec3 domain_max{1, 1, 1};
+    Vec3 gravity{0, -9.81f, 0};
+    FluidParams fluid;
+    SolverParams solver;
+    CellOrdering ordering = CellOrdering::kZOrder;
+};
+
+// Initial particles, every type in one list (the store keeps one list too).
+struct SimulationSetup {
+    SimulationParams params;
+    std::vector<Vec3> position;
+    std::vector<Vec3> velocity;
+    std::vector<std::uint8_t> type;
+    std::vector<std::int32_t> object;  // -1 for fluid and domain walls
+};
+
+// The particle state copied back to the host for output.
+struct HostParticles {
+    std::vector<Vec3> position, velocity;
+    std::vector<Real> density, pressure;
+    std::vector<std::uint8_t> type;
+    std::vector<std::int32_t> object;
+};
+
+struct StepReport {
+    long step = 0;
+    double time = 0;           // simulated time after the step, s
+    double dt = 0;             // the step just taken, s
+    int iterations = 0;        // PCISPH iterations
+    double density_error_avg = 0;  // average of max(ρ-ρ0,0)/ρ0 over fluid, last iteration
+    double density_error_max = 0;  // maximum of the same
+    double max_speed = 0;      // m/s over fluid
+    double kinetic_energy = 0; // J over fluid
+    long lost_particles = 0;   // fluid particles that have left the domain so far
+    std::vector<double> stage_ms;  // per stage, same order as stage_names(); 0 for a stage not run
+    double total_ms = 0;
+};
+
+struct ParticleCounts {
+    std::array<long, kParticleTypeCount> by_type{};
+    long total() const {
+        long n = 0;
+        for (long c : by_type) n += c;
+        return n;
+    }
+};
+
+class Simulation {
+   public:
+    virtual ~Simulation() = default;
+    // Advances one step. Throws SimulationError naming the step and particle on NaN/inf.
+    virtual void step() = 0;
+    virtual const StepReport& last_report() const = 0;
+    // The stages this scene runs, in the order of the method (a stage the scene does not need
+    // is absent: it costs no launch and no memory).
+    virtual std::vector<std::string> stage_names() const = 0;
+    virtual void download(HostParticles& out) const = 0;
+    virtual ParticleCounts counts() const = 0;
+    virtual std::size_t device_bytes() const = 0;
+    virtual double time() const = 0;
+    virtual std::string backend_name() const = 0;
+    virtual std::string device_name() const = 0;
+};
+
+}  // namespace mw

@@ -1,0 +1,89 @@
+// SPH smoothing kernels. A kernel is a small struct with W(r), grad W(r_vec) and the viscosity
+// Laplacian; the solver is written against that shape, so swapping the kernel is one alias
+// (`SphKernel` below).
+#pragma once
+#include <cmath>
+
+#include "algorithms/vec3.hpp"
+
+namespace mw {
+
+constexpr Real kPi = Real(3.14159265358979323846);
+
+// Cubic spline (Monaghan) with compact support h: W > 0 for r < h. Normalised in 3D.
+struct CubicSpline3D {
+    Real h = 1;
+    Real sigma = 0;        // 8 / (π h³)
+    Real grad_scale = 0;   // 48 / (π h⁴)
+    Real visc_scale = 0;   // 45 / (π h⁶), Müller et al. 2003 viscosity Laplacian
+
+    static CubicSpline3D with_support(Real support) {
+        CubicSpline3D k;
+        k.h = support;
+        k.sigma = Real(8) / (kPi * support * support * support);
+        k.grad_scale = Real(48) / (kPi * support * support * support * support);
+        k.visc_scale = Real(45) / (kPi * support * support * support * support * support * support);
+        return k;
+    }
+    MW_INLINE Real W(Real r) const {
+        const Real q = r / h;
+        if (q >= Real(1)) return Real(0);
+        if (q <= Real(0.5)) return sigma * (Real(6) * (q * q * q - q * q) + Real(1));
+        const Real t = Real(1) - q;
+        return sigma * Real(2) * t * t * t;
+    }
+    // ∇_i W(x_i - x_j) for r_vec = x_i - x_j, |r_vec| = r (passed in because callers have it).
+    MW_INLINE Vec3 grad_W(Vec3 r_vec, Real r) const {
+        const Real q = r / h;
+        if (q >= Real(1) || r <= Real(1e-9) * h) return Vec3{0, 0, 0};
+        Real dwdq;
+        if (q <= Real(0.5))
+            dwdq = q * (Real(3) * q - Real(2));
+        else {
+            const Real t = Real(1) - q;
+            dwdq = -t * t;
+        }
+        return (grad_scale * dwdq / r) * r_vec;
+    }
+    // Laplacian of the viscosity kernel; never negative, so viscosity never injects energy.
+    MW_INLINE Real laplacian_visc(Real r) const { return r < h ? visc_scale * (h - r) : Real(0); }
+};
+
+// Cubic spline normalised in 2D (for 2D scenes and the 2D δ check).
+struct CubicSpline2D {
+    Real h = 1;
+    Real sigma = 0;        // 40 / (7 π h²)
+    Real grad_scale = 0;   // 240 / (7 π h³)
+
+    static CubicSpline2D with_support(Real support) {
+        CubicSpline2D k;
+        k.h = support;
+        k.sigma = Real(40) / (Real(7) * kPi * support * support);
+        k.grad_scale = Real(240) / (Real(7) * kPi * support * support * support);
+        return k;
+    }
+    MW_INLINE Real W(Real r) const {
+        const Real q = r / h;
+        if (q >= Real(1)) return Real(0);
+        if (q <= Real(0.5)) return sigma * (Real(6) * (q * q * q - q * q) + Real(1));
+        const Real t = Real(1) - q;
+        return sigma * Real(2) * t * t * t;
+    }
+    MW_INLINE Vec3 grad_W(Vec3 r_vec, Real r) const {
+        const Real q = r / h;
+        if (q >= Real(1) || r <= Real(1e-9) * h) return Vec3{0, 0, 0};
+        Real dwdq;
+        if (q <= Real(0.5))
+            dwdq = q * (Real(3) * q - Real(2));
+        else {
+            const Real t = Real(1) - q;
+            dwdq = -t * t;
+        }
+        return (grad_scale * dwdq / r) * r_vec;
+    }
+};
+
+// The kernel the 3D solver uses.
+using SphKernel = CubicSpline3D;
+
+}  // namespace mw

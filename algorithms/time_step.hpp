@@ -1,0 +1,293 @@
+// One simulation on one backend. step() is the whole time step, top to bottom in the order of
+// the method (METHOD.md, "One time step"); each stage is a named, timed call into algorithms/.
+// Stages the scene does not need are not in the list: no launch, no memory.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "algorithms/array_ops.hpp"
+#include "algorithms/neighbor_grid.hpp"
+#include "algorithms/particle_store.hpp"
+#include "algorithms/pcisph.hpp"
+#include "algorithms/pcisph_delta.hpp"
+#include "algorithms/simulation.hpp"
+
+MW_BACKEND_BEGIN
+
+class BackendSimulation final : public Simulation {
+   public:
+    explicit BackendSimulation(const SimulationSetup& setup);
+
+    void step() override {
+        const SolverParams& solver = params_.solver;
+        const Real dt = choose_time_step();
+
+        // 1. Neighbour search: sort moving particles by cell, permute every field, cell ranges.
+        timers_.start(kNeighbors);
+        ranges_ = grid_.build(store_);
+        timers_.stop(kNeighbors);
+        const std::size_t fluid_count = ranges_.fluid_end;
+        const GridView grid = grid_.view();
+
+        // 2. Boundary volumes of moving solids (static ones were computed once).
+        //    (Added with deformable solids.)
+
+        // 3. Non-pressure forces: gravity, viscosity (Eq. 4).
+        if (has_viscosity_) {
+            timers_.start(kViscosity);
+            compute_viscosity_acceleration(grid, fluid_count, store_.position.cview(), store_.velocity.cview(),
+                                           store_.density.cview(), nonpressure_.view(), fluid_);
+            timers_.stop(kViscosity);
+        }
+        const Vec3* nonpressure = has_viscosity_ ? nonpressure_.view().data() : nullptr;
+
+        // 4. PCISPH: predict, density, pressure, pressure force, until the average density
+        //    error is below η (at least min, at most max iterations).
+        timers_.start(kPcisph);
+        const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
+        if (solver.warm_start > 0) {
+            scale_prefix(store_.pressure.view(), fluid_count, solver.warm_start);
+            // Start from last step's pressure (persistent, permuted with the particles): in a
+            // settled fluid the iterations then only correct what changed.
+            predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
+                              nullptr, predicted_.view(), fluid_.gravity, dt);
+            pressure_acceleration(grid, fluid_count, predicted_.cview(), store_.position.cview(),
+                                  boundary_volume_.cview(), store_.density.cview(), store_.pressure.cview(),
+                                  pressure_acc_.view(), fluid_);
+        } else {
+            fill_prefix(store_.pressure.view(), fluid_count, Real(0));
+            fill_prefix(pressure_acc_.view(), fluid_count, Vec3{0, 0, 0});
+        }
+        DensityError error;
+        int iterations = 0;
+        while (iterations < solver.max_iterations) {
+            predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
+                              pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt);
+            predict_density_and_pressure(grid, fluid_count, predicted_.cview(), store_.position.cview(),
+                                         boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
+                                         fluid_, delta);
+            error = density_error(fluid_count, store_.density.cview(), fluid_.rest_density);
+            pressure_acceleration(grid, fluid_count, predicted_.cview(), store_.position.cview(),
+                                  boundary_volume_.cview(), store_.density.cview(), store_.pressure.cview(),
+                                  pressure_acc_.view(), fluid_);
+            ++iterations;
+            const double average = fluid_count ? error.sum / double(fluid_count) : 0.0;
+            if (iterations >= solver.min_iterations && average <= solver.eta) break;
+        }
+        timers_.stop(kPcisph);
+
+        // 5.-6. Coupling forces and solids (LSM) go here with deformable solids.
+
+        // 7. Integrate fluid (symplectic Euler); guard against NaN/inf; statistics.
+        timers_.start(kIntegrate);
+        integrate_fluid(fluid_count, store_.position.view(), store_.velocity.view(), nonpressure,
+                        pressure_acc_.cview(), fluid_.gravity, dt);
+        const MotionSummary motion =
+            summarize_motion(fluid_count, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
+        timers_.stop(kIntegrate);
+
+        time_ += dt;
+        ++step_;
+        if (motion.first_bad != 0xffffffffu) report_non_finite(motion.first_bad);
+        fill_report(dt, iterations, error, fluid_count, motion);
+    }
+
+    const StepReport& last_report() const override { return report_; }
+    std::vector<std::string> stage_names() const override {
+        std::vector<std::string> names;
+        for (int stage : active_stages_) names.push_back(kStageNames[stage]);
+        return names;
+    }
+    void download(HostParticles& out) const override;
+    ParticleCounts counts() const override { return counts_; }
+    std::size_t device_bytes() const override {
+        return store_.bytes() + grid_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
+               pressure_acc_.bytes() + predicted_.bytes();
+    }
+    double time() const override { return time_; }
+    std::string backend_name() const override { return kBackendName; }
+    std::string device_name() const override { return device_description(); }
+
+   private:
+    enum Stage { kNeighbors, kViscosity, kPcisph, kIntegrate, kStageCount };
+    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "viscosity", "pcisph", "integrate"};
+
+    Real choose_time_step() const {
+        const SolverParams& solver = params_.solver;
+        if (solver.dt_mode == TimeStepMode::kFixed || last_max_speed_ <= 0) return solver.dt;
+        const Real cfl_dt = solver.cfl_number * params_.fluid.spacing / static_cast<Real>(last_max_speed_);
+        return std::max(solver.dt_min, std::min(solver.dt, cfl_dt));
+    }
+
+    void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
+                     const MotionSummary& motion) {
+        double stage_ms[kStageCount];
+        timers_.read(stage_ms);
+        report_.step = step_;
+        report_.time = time_;
+        report_.dt = dt;
+        report_.iterations = iterations;
+        report_.density_error_avg = fluid_count ? error.sum / double(fluid_count) : 0.0;
+        report_.density_error_max = error.max;
+        report_.max_speed = std::sqrt(double(motion.max_speed2));
+        report_.kinetic_energy = motion.kinetic_energy;
+        report_.lost_particles = static_cast<long>(store_.moving_count() - ranges_.solid_end) - inactive_by_design_;
+        report_.stage_ms.clear();
+        report_.total_ms = 0;
+        for (int stage : active_stages_) {
+            report_.stage_ms.push_back(stage_ms[stage]);
+            report_.total_ms += stage_ms[stage];
+        }
+        last_max_speed_ = report_.max_speed;
+    }
+
+    void report_non_finite(std::uint32_t index) const {
+        std::uint32_t scene_index = 0;
+        Vec3 x{0, 0, 0}, v{0, 0, 0};
+        store_.id.download_range(&scene_index, index, 1);
+        store_.position.download_range(&x, index, 1);
+        store_.velocity.download_range(&v, index, 1);
+        char text[320];
+        std::snprintf(text, sizeof text,
+                      "step %ld (t = %.6g s): fluid particle %u became non-finite (position %g %g %g, velocity %g "
+                      "%g %g); try a smaller dt, or dt_mode \"cfl\"",
+                      step_, time_, scene_index, double(x.x), double(x.y), double(x.z), double(v.x), double(v.y),
+                      double(v.z));
+        throw SimulationError(text);
+    }
+
+    SimulationParams params_;
+    FluidConstants fluid_;
+    double delta_times_dt2_ = 0;  // δ·Δt², from the prototype lattice
+    ParticleStore store_;
+    NeighborGrid grid_;
+    GroupRanges ranges_;
+    DeviceArray<Real> boundary_volume_;   // V_b, indexed like the store (fluid entries unused)
+    DeviceArray<Vec3> nonpressure_;       // gravity + viscosity; only when μ > 0
+    DeviceArray<Vec3> pressure_acc_;
+    DeviceArray<Vec3> predicted_;
+    StageTimers timers_{kStageCount};
+    std::vector<int> active_stages_;
+    bool has_viscosity_ = false;
+    ParticleCounts counts_;
+    long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
+    double time_ = 0;
+    long step_ = 0;
+    double last_max_speed_ = 0;
+    StepReport report_;
+};
+
+inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : params_(setup.params) {
+    const std::size_t n = setup.position.size();
+    if (setup.velocity.size() != n || setup.type.size() != n || setup.object.size() != n)
+        throw InputError("simulation setup: position, velocity, type and object lists differ in length");
+    const FluidParams& fp = params_.fluid;
+    if (!(fp.spacing > 0) || !(fp.support_radius > fp.spacing) || !(fp.rest_density > 0))
+        throw InputError("simulation setup: need spacing > 0, support_radius > spacing, rest_density > 0");
+
+    // Moving particles first, static boundary last (stable, so ids keep the scene's order).
+    std::vector<std::uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_partition(order.begin(), order.end(),
+                          [&](std::uint32_t i) { return setup.type[i] != kStaticBoundary; });
+    std::size_t moving = 0;
+    std::vector<Vec3> position(n), velocity(n);
+    std::vector<std::uint8_t> type(n);
+    std::vector<std::int32_t> object(n);
+    Vec3 lo = params_.domain_min, hi = params_.domain_max;
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t i = order[k];
+        position[k] = setup.position[i];
+        velocity[k] = setup.velocity[i];
+        type[k] = setup.type[i];
+        object[k] = setup.object[i];
+        if (type[k] > kGeometry) throw InputError("simulation setup: unknown particle type " + std::to_string(type[k]));
+        if (type[k] != kStaticBoundary) ++moving;
+        ++counts_.by_type[type[k]];
+        if (type[k] == kGeometry) ++inactive_by_design_;
+        if (!is_finite(position[k]) || !is_finite(velocity[k]))
+            throw InputError("simulation setup: particle " + std::to_string(i) + " has a non-finite position or velocity");
+        if (type[k] == kStaticBoundary) {  // the grid must hold every static particle
+            lo = Vec3{std::min(lo.x, position[k].x), std::min(lo.y, position[k].y), std::min(lo.z, position[k].z)};
+            hi = Vec3{std::max(hi.x, position[k].x), std::max(hi.y, position[k].y), std::max(hi.z, position[k].z)};
+        }
+    }
+
+    store_.resize(n, moving);
+    store_.id.upload(order);
+    store_.position.upload(position);
+    store_.velocity.upload(velocity);
+    store_.type.upload(type);
+    store_.object.upload(object);
+    store_.density.fill(fp.rest_density);
+    store_.pressure.fill(Real(0));
+
+    // The grid covers the domain, its walls and one support radius more; fluid that leaves it is
+    // counted as lost.
+    const Real h = fp.support_radius;
+    grid_.configure(Vec3{lo.x - h, lo.y - h, lo.z - h}, Vec3{hi.x + h, hi.y + h, hi.z + h}, h, params_.ordering);
+    grid_.build_static(store_);
+
+    fluid_.kernel = SphKernel::with_support(h);
+    fluid_.support2 = h * h;
+    fluid_.rest_density = fp.rest_density;
+    fluid_.viscosity = fp.viscosity;
+    fluid_.gravity = params_.gravity;
+    // Mass such that the prototype lattice at spacing r0 has exactly the rest density.
+    const PrototypeSums sums = prototype_sums(fluid_.kernel, fp.spacing, 3);
+    fluid_.mass = static_cast<Real>(fp.rest_density / sums.sum_W);
+    delta_times_dt2_ = pcisph_delta(sums, fp.rest_density, fluid_.mass, 1.0);
+
+    boundary_volume_.resize(n);
+    if (store_.static_count())
+        compute_boundary_volumes(grid_.view(), store_.position.cview(), boundary_volume_.view(), moving,
+                                 store_.static_count(), false, fluid_.kernel);
+
+    has_viscosity_ = fp.viscosity > 0;
+    active_stages_.push_back(kNeighbors);
+    if (has_viscosity_) {
+        active_stages_.push_back(kViscosity);
+        nonpressure_.resize(moving);
+    }
+    active_stages_.push_back(kPcisph);
+    active_stages_.push_back(kIntegrate);
+    pressure_acc_.resize(moving);
+    predicted_.resize(moving);
+
+    // The first CFL step uses the initial speeds.
+    double max_speed2 = 0;
+    for (std::size_t k = 0; k < moving; ++k) max_speed2 = std::max(max_speed2, double(norm2(velocity[k])));
+    last_max_speed_ = std::sqrt(max_speed2);
+}
+
+inline void BackendSimulation::download(HostParticles& out) const {
+    const std::size_t n = store_.size();
+    const std::vector<std::uint32_t> id = store_.id.to_host();
+    const std::vector<Vec3> position = store_.position.to_host(), velocity = store_.velocity.to_host();
+    const std::vector<Real> density = store_.density.to_host(), pressure = store_.pressure.to_host();
+    const std::vector<std::uint8_t> type = store_.type.to_host();
+    const std::vector<std::int32_t> object = store_.object.to_host();
+    out.position.resize(n);
+    out.velocity.resize(n);
+    out.density.resize(n);
+    out.pressure.resize(n);
+    out.type.resize(n);
+    out.object.resize(n);
+    // Back to the scene's order, so that frames and cross-backend comparisons line up.
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t i = id[k];
+        const bool fluid = type[k] == kFluid && k < ranges_.fluid_end;
+        out.position[i] = position[k];
+        out.velocity[i] = velocity[k];
+        out.density[i] = fluid ? density[k] : fluid_.rest_density;
+        out.pressure[i] = fluid ? pressure[k] : Real(0);
+        out.type[i] = type[k];
+        out.object[i] = object[k];
+    }
+}
+
+MW_BACKEND_END

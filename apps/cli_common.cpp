@@ -1,0 +1,111 @@
+#include "apps/cli_common.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "backend/backend_registry.hpp"
+#include "backend/errors.hpp"
+
+namespace mw {
+
+void add_scene_options(cxxopts::Options& options) {
+    options.add_options()
+        ("scene", "scene file (JSON); the built-in 3D dam break when omitted", cxxopts::value<std::string>())
+        ("set", "override a scene key, e.g. --set solver.dt=0.002 or --set gravity=[0,-1,0] (repeatable)",
+         cxxopts::value<std::string>())
+        ("h,help", "show this help");
+    options.parse_positional({"scene"});
+    options.positional_help("[SCENE]");
+}
+
+cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** argv,
+                                   std::vector<std::string>* overrides) {
+    std::vector<char*> rest;
+    for (int i = 0; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (overrides && i > 0 && a == "--set") {
+            if (i + 1 >= argc) throw InputError("--set needs KEY=VALUE, for example --set solver.dt=0.002");
+            overrides->push_back(argv[++i]);
+        } else if (overrides && i > 0 && a.rfind("--set=", 0) == 0) {
+            overrides->push_back(a.substr(6));
+        } else {
+            rest.push_back(argv[i]);
+        }
+    }
+    try {
+        cxxopts::ParseResult result = options.parse(static_cast<int>(rest.size()), rest.data());
+        if (!result.unmatched().empty())
+            throw InputError("unexpected argument '" + result.unmatched().front() + "' (one scene at most)");
+        return result;
+    } catch (const cxxopts::exceptions::exception& e) {
+        throw InputError(e.what());
+    }
+}
+
+Scene scene_from_options(const cxxopts::ParseResult& result, const std::vector<std::string>& overrides) {
+    std::string path;
+    if (result.count("scene")) {
+        path = result["scene"].as<std::string>();
+        if (path.empty()) throw InputError("empty scene path");
+    }
+    return load_scene(path, overrides);
+}
+
+std::string choose_backend(const std::string& requested) {
+    if (requested == "openmp") return "openmp";
+    if (requested == "cuda") {
+        const BackendInfo cuda = cuda_backend_info();
+        if (!cuda.available) throw DeviceError("--backend cuda: CUDA is not available: " + cuda.description);
+        return "cuda";
+    }
+    if (requested == "auto") return cuda_backend_info().available ? "cuda" : "openmp";
+    throw InputError("--backend: expected auto, cuda or openmp, got '" + requested + "'");
+}
+
+std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, const std::string& backend, int threads) {
+    if (backend == "openmp") return create_openmp_simulation(setup, threads);
+    try {
+        return create_cuda_simulation(setup);
+    } catch (const DeviceError& e) {
+        // Add what the scene asks for, measured on the host backend (same layout), when cheap enough.
+        std::string estimate;
+        if (setup.position.size() <= 20'000'000) {
+            try {
+                auto probe = create_openmp_simulation(setup, 1);
+                estimate = ", estimated " + format_bytes(double(probe->device_bytes()));
+            } catch (const std::exception&) {
+            }
+        }
+        throw DeviceError(std::string(e.what()) + " (scene: " + with_thousands(long(setup.position.size())) +
+                          " particles" + estimate + ")");
+    }
+}
+
+std::string with_thousands(long n) {
+    std::string digits = std::to_string(n < 0 ? -n : n), out;
+    for (std::size_t i = 0; i < digits.size(); ++i) {
+        if (i && (digits.size() - i) % 3 == 0) out += ',';
+        out += digits[i];
+    }
+    return n < 0 ? "-" + out : out;
+}
+
+std::string format_bytes(double bytes) {
+    const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+    int u = 0;
+    while (bytes >= 1024 && u < 4) bytes /= 1024, ++u;
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, u ? "%.1f %s" : "%.0f %s", bytes, units[u]);
+    return buffer;
+}
+
+std::string format_duration(double seconds) {
+    if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+    long s = std::lround(seconds);
+    char buffer[32];
+    if (s >= 3600) std::snprintf(buffer, sizeof buffer, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+    else std::snprintf(buffer, sizeof buffer, "%ld:%02ld", s / 60, s % 60);
+    return buffer;
+}
+
+}  // namespace mw

@@ -1,0 +1,39 @@
+// Pieces shared by the `meltwater` subcommands: option parsing that turns cxxopts' exceptions into
+// one-line InputErrors, scene loading from the command line, backend choice, number formatting.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <cxxopts.hpp>
+
+#include "algorithms/simulation.hpp"
+#include "apps/scene.hpp"
+
+namespace mw {
+
+// Adds the positional SCENE argument and --set to `options`.
+void add_scene_options(cxxopts::Options& options);
+
+// Parses, converting every cxxopts complaint (unknown option, missing or bad value) to InputError.
+// `--set K=V` / `--set=K=V` are taken out first and kept in order in `overrides` (cxxopts would
+// split their values at commas, breaking `--set gravity=[0,-1,0]`).
+cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** argv,
+                                   std::vector<std::string>* overrides = nullptr);
+
+// The scene named on the command line (or the built-in default) with the --set overrides applied.
+Scene scene_from_options(const cxxopts::ParseResult& result, const std::vector<std::string>& overrides);
+
+// "auto" (CUDA when a GPU is usable, else OpenMP), "cuda" or "openmp". Throws InputError for an
+// unknown name and DeviceError when CUDA is asked for and unavailable.
+std::string choose_backend(const std::string& requested);
+
+// Creates the simulation on the chosen backend; a DeviceError on creation (out of GPU memory) is
+// re-thrown with the particle count and the memory estimate.
+std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, const std::string& backend, int threads);
+
+std::string with_thousands(long n);
+std::string format_bytes(double bytes);
+std::string format_duration(double seconds);  // h:mm:ss or m:ss
+
+}  // namespace mw

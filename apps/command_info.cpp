@@ -1,0 +1,83 @@
+// `meltwater info [SCENE]`: what a run of the scene would create and run, without running it.
+#include <cmath>
+#include <cstdio>
+
+#include "apps/cli_common.hpp"
+#include "apps/commands.hpp"
+#include "apps/scene_builder.hpp"
+#include "backend/backend_registry.hpp"
+#include "backend/errors.hpp"
+
+namespace mw {
+
+int command_info(int argc, char** argv) {
+    cxxopts::Options options("meltwater info",
+                             "Particle counts by type, the memory estimate and the stages a run of SCENE\n"
+                             "(the built-in 3D dam break when omitted) would use.");
+    add_scene_options(options);
+    options.add_options()("json", "print one JSON object instead of text");
+    std::vector<std::string> overrides;
+    const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
+    if (args.count("help")) {
+        std::printf("%s\n", options.help().c_str());
+        return 0;
+    }
+    const Scene scene = scene_from_options(args, overrides);
+    const SimulationSetup setup = build_setup(scene);
+    const ParticleCounts counts = count_particles(setup);
+    // The layout is the same on both backends: measure it on the host one.
+    std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    const std::size_t bytes = sim->device_bytes();
+    const std::vector<std::string> stages = sim->stage_names();
+    const double bytes_per_particle = counts.total() ? double(bytes) / double(counts.total()) : 0.0;
+    const SolverParams& solver = scene.params.solver;
+    const bool cfl = solver.dt_mode == TimeStepMode::kCfl;
+    const long frames = scene.writes_vtu() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
+
+    if (args.count("json")) {
+        SceneJson j;
+        j["scene_name"] = scene.name;
+        j["scene_source"] = scene.source;
+        SceneJson p;
+        for (int t = 0; t < kParticleTypeCount; ++t) p[particle_type_name(t)] = counts.by_type[t];
+        p["total"] = counts.total();
+        j["particles"] = p;
+        j["device_bytes"] = bytes;
+        j["bytes_per_particle"] = bytes_per_particle;
+        j["stages"] = stages;
+        j["frames"] = frames;
+        j["scene"] = scene.resolved;
+        std::printf("%s\n", j.dump(2).c_str());
+        return 0;
+    }
+
+    std::printf("scene       %s (%s)\n", scene.name.empty() ? "(unnamed)" : scene.name.c_str(), scene.source.c_str());
+    std::printf("particles  ");
+    for (int t = 0; t < kParticleTypeCount; ++t)
+        std::printf(" %s %s |", particle_type_name(t), with_thousands(counts.by_type[t]).c_str());
+    std::printf(" total %s\n", with_thousands(counts.total()).c_str());
+    std::printf("memory      %s estimated on the device (%.0f bytes/particle)\n", format_bytes(double(bytes)).c_str(),
+                bytes_per_particle);
+    std::printf("stages     ");
+    for (std::size_t i = 0; i < stages.size(); ++i) std::printf("%s %s", i ? "," : "", stages[i].c_str());
+    std::printf("\n");
+    const FluidParams& f = scene.params.fluid;
+    std::printf("fluid       r0 %g m, h %g m, rest density %g kg/m3, viscosity %g Pa s%s\n", double(f.spacing),
+                double(f.support_radius), double(f.rest_density), double(f.viscosity),
+                f.viscosity > 0 ? "" : " (viscosity stage off)");
+    if (cfl)
+        std::printf("solver      CFL time step (number %g, at most %g s), eta %g, %d..%d iterations\n",
+                    double(solver.cfl_number), double(solver.dt), double(solver.eta), solver.min_iterations,
+                    solver.max_iterations);
+    else
+        std::printf("solver      fixed time step %g s (%ld steps to t=%g s), eta %g, %d..%d iterations\n",
+                    double(solver.dt), static_cast<long>(std::ceil(scene.end_time / solver.dt - 1e-9)), scene.end_time,
+                    double(solver.eta), solver.min_iterations, solver.max_iterations);
+    std::printf("run         to t=%g s; %ld frames (%g per simulated second)\n", scene.end_time, frames, scene.fps);
+    std::printf("boundary    %s, %d layer(s) at %g m; %zu static box(es)\n",
+                scene.walls ? "domain walls" : "no domain walls", scene.boundary_layers,
+                double(scene.boundary_spacing()), scene.static_boxes.size());
+    return 0;
+}
+
+}  // namespace mw

@@ -1,0 +1,200 @@
+// `meltwater run [SCENE]`: simulate, writing frames, stats.csv and summary.json into --out.
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+
+#include "apps/cli_common.hpp"
+#include "apps/commands.hpp"
+#include "apps/progress.hpp"
+#include "apps/run_outputs.hpp"
+#include "apps/scene_builder.hpp"
+#include "apps/atomic_file.hpp"
+#include "backend/errors.hpp"
+
+namespace mw {
+
+namespace {
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_interrupt(int) { g_interrupted = 1; }
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+}  // namespace
+
+int command_run(int argc, char** argv) {
+    cxxopts::Options options("meltwater run",
+                             "Simulate a scene (the built-in 3D dam break when no SCENE is given) and write\n"
+                             "frames/particles_NNNNN.vtu, stats.csv and summary.json into the output directory.");
+    add_scene_options(options);
+    options.add_options()
+        ("backend", "auto, cuda or openmp", cxxopts::value<std::string>()->default_value("auto"))
+        ("out", "output directory (default results/<scene name>)", cxxopts::value<std::string>())
+        ("steps", "run exactly N steps", cxxopts::value<long>())
+        ("time", "run to simulated time T seconds (default: the scene's run.end_time)", cxxopts::value<double>())
+        ("threads", "OpenMP threads (default: all cores)", cxxopts::value<int>())
+        ("q,quiet", "print only the final summary line and errors");
+    std::vector<std::string> overrides;
+    const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
+    if (args.count("help")) {
+        std::printf("%s\n", options.help().c_str());
+        return 0;
+    }
+    if (args.count("steps") && args.count("time")) throw InputError("--steps and --time exclude each other; give one");
+    long end_steps = 0;
+    if (args.count("steps")) {
+        end_steps = args["steps"].as<long>();
+        if (end_steps < 1) throw InputError("--steps must be at least 1, got " + std::to_string(end_steps));
+    }
+    int threads = 0;
+    if (args.count("threads")) {
+        threads = args["threads"].as<int>();
+        if (threads < 1) throw InputError("--threads must be at least 1, got " + std::to_string(threads));
+    }
+    const bool quiet = args.count("quiet") > 0;
+
+    Scene scene = scene_from_options(args, overrides);
+    double end_time = scene.end_time;
+    if (args.count("time")) {
+        end_time = args["time"].as<double>();
+        if (!(end_time > 0) || !std::isfinite(end_time))
+            throw InputError("--time must be a positive number of seconds, got " + std::to_string(end_time));
+    }
+    const std::string backend = choose_backend(args["backend"].as<std::string>());
+    if (threads > 0 && backend != "openmp" && !quiet)
+        std::fprintf(stderr, "meltwater: note: --threads applies to the openmp backend only\n");
+    const std::string out_dir =
+        args.count("out") ? args["out"].as<std::string>() : "results/" + (scene.name.empty() ? "run" : scene.name);
+    if (out_dir.empty()) throw InputError("--out: empty directory name");
+
+    const SimulationSetup setup = build_setup(scene);
+    std::unique_ptr<Simulation> sim = create_simulation(setup, backend, threads);
+
+    make_directories(out_dir);
+    const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
+    std::unique_ptr<FrameWriter> frames;
+    if (scene.writes_vtu()) frames = std::make_unique<FrameWriter>(out_dir);
+    StatsTable stats(sim->stage_names());
+
+    RunSummary summary;
+    summary.backend = sim->backend_name();
+    summary.device = sim->device_name();
+    summary.threads = threads;
+    summary.particles = sim->counts();
+    summary.device_bytes = sim->device_bytes();
+    char stop[64];
+    if (end_steps > 0) std::snprintf(stop, sizeof stop, "steps %ld", end_steps);
+    else std::snprintf(stop, sizeof stop, "time %g s", end_time);
+    summary.stop_condition = stop;
+
+    if (!quiet) {
+        const ParticleCounts& c = summary.particles;
+        std::fprintf(stderr, "meltwater: %s (%s): %s particles (%s fluid, %s boundary) on %s [%s], %s; output in %s\n",
+                     scene.name.empty() ? "scene" : scene.name.c_str(), scene.source.c_str(),
+                     with_thousands(c.total()).c_str(), with_thousands(c.by_type[kFluid]).c_str(),
+                     with_thousands(c.total() - c.by_type[kFluid]).c_str(), summary.backend.c_str(),
+                     summary.device.c_str(), stop, out_dir.c_str());
+    }
+
+    const auto wall_start = std::chrono::steady_clock::now();
+    auto last_stats_write = wall_start;
+    HostParticles host;
+    int frame_index = 0;
+    auto write_frame = [&]() {
+        if (!frames) return;
+        sim->download(host);
+        frames->write(frame_index, host, sim->time());
+        ++frame_index;
+    };
+
+    g_interrupted = 0;
+    auto previous_handler = std::signal(SIGINT, on_interrupt);
+    std::exception_ptr failure;
+    bool interrupted = false;
+    try {
+        write_frame();  // frame 0: the initial state
+        const double frame_dt = 1.0 / scene.fps;
+        double next_frame_time = frame_dt;
+        Progress progress(quiet ? Progress::Mode::kQuiet : Progress::Mode::kAuto, end_steps, end_time);
+        long steps_done = 0;
+        // Stop at the step that reaches end_time (to a relative tolerance, so 0.1 + 0.1 + ... counts).
+        while (end_steps > 0 ? steps_done < end_steps : sim->time() < end_time * (1 - 1e-9)) {
+            if (g_interrupted) {
+                interrupted = true;
+                break;
+            }
+            try {
+                sim->step();
+            } catch (...) {
+                progress.finish();
+                throw;
+            }
+            ++steps_done;
+            const StepReport& r = sim->last_report();
+            stats.add(r);
+            summary.steps = steps_done;
+            summary.simulated_time = r.time;
+            summary.lost_particles = r.lost_particles;
+            progress.update(r);
+            if (r.time >= next_frame_time * (1 - 1e-9)) {
+                write_frame();
+                // The next frame time after now (a step longer than 1/fps skips frame times).
+                next_frame_time = (std::floor(r.time / frame_dt * (1 + 1e-9)) + 1) * frame_dt;
+            }
+            if (seconds_since(last_stats_write) > 5) {  // keep stats.csv current for a run that dies
+                stats.write(stats_path);
+                last_stats_write = std::chrono::steady_clock::now();
+            }
+        }
+        progress.finish();
+    } catch (...) {
+        failure = std::current_exception();
+    }
+    std::signal(SIGINT, previous_handler);
+
+    summary.wall_seconds = seconds_since(wall_start);
+    summary.frames = frames ? frames->written() : 0;
+    if (failure) {
+        summary.status = "failed";
+        try {
+            std::rethrow_exception(failure);
+        } catch (const std::exception& e) {
+            summary.error = e.what();
+        }
+    } else if (interrupted) {
+        summary.status = "interrupted";
+    }
+    // Whatever happened, leave whole stats.csv and summary.json behind.
+    try {
+        stats.write(stats_path);
+        write_summary(summary_path, summary, stats, scene);
+    } catch (const std::exception& e) {
+        if (!failure) throw;
+        std::fprintf(stderr, "meltwater: error: could not record the failure: %s\n", e.what());
+    }
+    if (failure) {
+        std::fprintf(stderr, "meltwater: stopped after %ld steps at t=%.4g s; %d frames, stats.csv and summary.json kept in %s\n",
+                     summary.steps, summary.simulated_time, summary.frames, out_dir.c_str());
+        std::rethrow_exception(failure);
+    }
+
+    if (summary.lost_particles > 0)
+        std::fprintf(stderr, "meltwater: warning: %s fluid particles left the domain (column lost_particles of stats.csv)\n",
+                     with_thousands(summary.lost_particles).c_str());
+    std::error_code ec;
+    const std::string shown = std::filesystem::absolute(out_dir, ec).lexically_normal().string();
+    std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, density error avg %.3g%% max %.3g%%, "
+                "%.1f iterations/step)\n",
+                interrupted ? "interrupted after" : "ran", summary.steps, summary.simulated_time, summary.wall_seconds,
+                stats.median_total_ms(), 100 * stats.density_error_avg(), 100 * stats.density_error_max(),
+                stats.iterations_avg());
+    std::printf("meltwater: results in %s (%d frames in frames/, stats.csv, summary.json)\n",
+                ec ? out_dir.c_str() : shown.c_str(), summary.frames);
+    std::fflush(stdout);
+    return interrupted ? 130 : 0;
+}
+
+}  // namespace mw

@@ -1,0 +1,49 @@
+// `meltwater`: the command line. Dispatches to one subcommand; every error a user can cause is
+// one line on stderr and a non-zero exit.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "apps/commands.hpp"
+#include "backend/errors.hpp"
+
+namespace {
+void print_usage() {
+    std::printf(
+        "usage: meltwater <command> [options]\n"
+        "  run [SCENE]      simulate a scene (the built-in 3D dam break when no scene is given)\n"
+        "  info [SCENE]     particle counts, memory estimate and the stages that will run\n"
+        "  backends         the backends compiled in and the devices found\n"
+        "  sample MESH      sample a mesh into surface, inner and geometry particles\n"
+        "Run 'meltwater <command> --help' for the options of a command.\n");
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+        print_usage();
+        return argc < 2 ? 2 : 0;
+    }
+    const std::string command = argv[1];
+    try {
+        if (command == "run") return mw::command_run(argc - 1, argv + 1);
+        if (command == "info") return mw::command_info(argc - 1, argv + 1);
+        if (command == "backends") return mw::command_backends(argc - 1, argv + 1);
+        if (command == "sample") return mw::command_sample(argc - 1, argv + 1);
+        std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample)\n", command.c_str());
+        return 2;
+    } catch (const mw::InputError& e) {
+        std::fprintf(stderr, "meltwater: error: %s\n", e.what());
+        return 2;
+    } catch (const mw::DeviceError& e) {
+        std::fprintf(stderr, "meltwater: device error: %s\n", e.what());
+        return 3;
+    } catch (const mw::SimulationError& e) {
+        std::fprintf(stderr, "meltwater: simulation failed: %s\n", e.what());
+        return 4;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "meltwater: error: %s\n", e.what());
+        return 1;
+    }
+}

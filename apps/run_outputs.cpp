@@ -1,0 +1,181 @@
+#include "apps/run_outputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <ostream>
+
+#include "apps/atomic_file.hpp"
+#include "apps/vtu_writer.hpp"
+#include "backend/errors.hpp"
+
+namespace mw {
+
+namespace {
+double median(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+std::vector<float> to_floats(const std::vector<Real>& v) { return std::vector<float>(v.begin(), v.end()); }
+
+// JSON numbers must be finite; a NaN would make nlohmann write `null` anyway, say so explicitly.
+SceneJson finite_or_null(double v) { return std::isfinite(v) ? SceneJson(v) : SceneJson(nullptr); }
+}  // namespace
+
+FrameWriter::FrameWriter(const std::string& out_dir) : frames_dir_(out_dir + "/frames") {
+    make_directories(frames_dir_);
+    // Frames of an earlier run into the same directory would mix with this run's: remove them.
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(frames_dir_, error)) {
+        const std::string name = entry.path().filename().string();
+        if ((name.rfind("particles_", 0) == 0 && entry.path().extension() == ".vtu") || name == "particles.pvd")
+            std::filesystem::remove(entry.path(), error);
+    }
+}
+
+std::string FrameWriter::write(int index, const HostParticles& p, double time) {
+    char name[64];
+    std::snprintf(name, sizeof name, "particles_%05d.vtu", index);
+    const std::string path = frames_dir_ + "/" + name;
+    std::vector<VtuArray> arrays;
+    arrays.push_back(VtuArray::vector3("velocity", p.velocity));
+    arrays.push_back(VtuArray::scalar("density", to_floats(p.density)));
+    arrays.push_back(VtuArray::scalar("pressure", to_floats(p.pressure)));
+    arrays.push_back(VtuArray::uint8("type", p.type));
+    arrays.push_back(VtuArray::int32("object", p.object));
+    write_vtu(path, p.position, arrays);
+    ++written_;
+    collection_.emplace_back(time, name);
+    write_file_atomically(frames_dir_ + "/particles.pvd", [&](std::ostream& out) {
+        out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+        char line[160];
+        for (const auto& [t, file] : collection_) {
+            std::snprintf(line, sizeof line, "    <DataSet timestep=\"%.9g\" part=\"0\" file=\"%s\"/>\n", t, file.c_str());
+            out << line;
+        }
+        out << "  </Collection>\n</VTKFile>\n";
+    });
+    return path;
+}
+
+StatsTable::StatsTable(std::vector<std::string> stage_names) : stages_(std::move(stage_names)) {}
+
+void StatsTable::add(const StepReport& report) { reports_.push_back(report); }
+
+std::string StatsTable::header() const {
+    std::string h =
+        "step,time,dt,iterations,density_error_avg,density_error_max,max_speed,kinetic_energy,lost_particles";
+    for (const auto& s : stages_) h += ",ms_" + s;
+    return h + ",ms_total";
+}
+
+void StatsTable::write(const std::string& path) const {
+    write_file_atomically(path, [&](std::ostream& out) {
+        out << header() << '\n';
+        char buffer[96];
+        for (const StepReport& r : reports_) {
+            std::snprintf(buffer, sizeof buffer, "%ld,%.9g,%.9g,%d,", r.step, r.time, r.dt, r.iterations);
+            out << buffer;
+            std::snprintf(buffer, sizeof buffer, "%.6g,%.6g,%.6g,%.6g,%ld", r.density_error_avg, r.density_error_max,
+                          r.max_speed, r.kinetic_energy, r.lost_particles);
+            out << buffer;
+            for (std::size_t s = 0; s < stages_.size(); ++s) {
+                std::snprintf(buffer, sizeof buffer, ",%.4f", s < r.stage_ms.size() ? r.stage_ms[s] : 0.0);
+                out << buffer;
+            }
+            std::snprintf(buffer, sizeof buffer, ",%.4f\n", r.total_ms);
+            out << buffer;
+        }
+    });
+}
+
+std::vector<double> StatsTable::median_stage_ms() const {
+    std::vector<double> out;
+    for (std::size_t s = 0; s < stages_.size(); ++s) {
+        std::vector<double> v;
+        for (const auto& r : reports_) v.push_back(s < r.stage_ms.size() ? r.stage_ms[s] : 0.0);
+        out.push_back(median(v));
+    }
+    return out;
+}
+
+double StatsTable::median_total_ms() const {
+    std::vector<double> v;
+    for (const auto& r : reports_) v.push_back(r.total_ms);
+    return median(v);
+}
+
+double StatsTable::density_error_avg() const {
+    if (reports_.empty()) return 0;
+    double s = 0;
+    for (const auto& r : reports_) s += r.density_error_avg;
+    return s / reports_.size();
+}
+
+double StatsTable::density_error_max() const {
+    double m = 0;
+    for (const auto& r : reports_) m = std::max(m, r.density_error_max);
+    return m;
+}
+
+double StatsTable::iterations_avg() const {
+    if (reports_.empty()) return 0;
+    double s = 0;
+    for (const auto& r : reports_) s += r.iterations;
+    return s / reports_.size();
+}
+
+int StatsTable::iterations_max() const {
+    int m = 0;
+    for (const auto& r : reports_) m = std::max(m, r.iterations);
+    return m;
+}
+
+double StatsTable::sum_total_ms() const {
+    double s = 0;
+    for (const auto& r : reports_) s += r.total_ms;
+    return s;
+}
+
+void write_summary(const std::string& path, const RunSummary& run, const StatsTable& stats, const Scene& scene) {
+    SceneJson j;
+    j["status"] = run.status;
+    if (!run.error.empty()) j["error"] = run.error;
+    j["backend"] = run.backend;
+    j["device"] = run.device;
+    if (run.backend == "openmp" && run.threads > 0) j["threads"] = run.threads;
+    j["scene_name"] = scene.name;
+    j["scene_source"] = scene.source;
+    j["stop_condition"] = run.stop_condition;
+    j["steps"] = run.steps;
+    j["simulated_time"] = finite_or_null(run.simulated_time);
+    j["wall_seconds"] = run.wall_seconds;
+    SceneJson particles;
+    for (int t = 0; t < kParticleTypeCount; ++t) particles[particle_type_name(t)] = run.particles.by_type[t];
+    particles["total"] = run.particles.total();
+    j["particles"] = particles;
+    j["lost_particles"] = run.lost_particles;
+    SceneJson ms;
+    const std::vector<double> medians = stats.median_stage_ms();
+    for (std::size_t s = 0; s < medians.size(); ++s) ms[stats.stage_names()[s]] = medians[s];
+    ms["total"] = stats.median_total_ms();
+    j["ms_per_step"] = ms;
+    const double step_seconds = stats.sum_total_ms() / 1000.0;
+    j["particle_steps_per_second"] =
+        step_seconds > 0 ? double(run.particles.total()) * double(stats.rows()) / step_seconds : 0.0;
+    j["density_error"] = {{"avg", finite_or_null(stats.density_error_avg())},
+                          {"max", finite_or_null(stats.density_error_max())}};
+    j["iterations"] = {{"avg", stats.iterations_avg()}, {"max", stats.iterations_max()}};
+    j["device_bytes"] = run.device_bytes;
+    j["bytes_per_particle"] =
+        run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;
+    j["frames"] = run.frames;
+    j["scene"] = scene.resolved;
+    const std::string text = j.dump(2) + "\n";
+    write_file_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
+}  // namespace mw

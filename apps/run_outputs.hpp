@@ -1,0 +1,72 @@
+// What `meltwater run` writes into its output directory, each file atomically:
+//   frames/particles_NNNNN.vtu   the particles (velocity, density, pressure, type, object)
+//   stats.csv                    one row per step
+//   summary.json                 the run in one object, the resolved scene included
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "algorithms/simulation.hpp"
+#include "apps/scene.hpp"
+
+namespace mw {
+
+// Writes frames/particles_NNNNN.vtu.
+class FrameWriter {
+   public:
+    explicit FrameWriter(const std::string& out_dir);  // creates frames/, removes stale particles_*.vtu
+    // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView
+    // collection listing every frame with its time. Returns the frame's path.
+    std::string write(int index, const HostParticles& particles, double time);
+    int written() const { return written_; }
+    const std::string& directory() const { return frames_dir_; }
+
+   private:
+    std::string frames_dir_;
+    int written_ = 0;
+    std::vector<std::pair<double, std::string>> collection_;
+};
+
+// Per-step statistics kept in memory and rewritten atomically (so stats.csv is always whole).
+class StatsTable {
+   public:
+    explicit StatsTable(std::vector<std::string> stage_names);
+    void add(const StepReport& report);
+    std::string header() const;
+    void write(const std::string& path) const;
+
+    std::size_t rows() const { return reports_.size(); }
+    const std::vector<std::string>& stage_names() const { return stages_; }
+    // Medians of each stage's ms and of the total, in stage order, then "total".
+    std::vector<double> median_stage_ms() const;
+    double median_total_ms() const;
+    double density_error_avg() const;  // mean over steps of the per-step average
+    double density_error_max() const;  // max over steps of the per-step maximum
+    double iterations_avg() const;
+    int iterations_max() const;
+    double sum_total_ms() const;
+
+   private:
+    std::vector<std::string> stages_;
+    std::vector<StepReport> reports_;
+};
+
+struct RunSummary {
+    std::string status = "completed";  // or "failed"
+    std::string error;
+    std::string backend, device;
+    int threads = 0;
+    long steps = 0;
+    double simulated_time = 0;
+    double wall_seconds = 0;
+    long lost_particles = 0;
+    ParticleCounts particles;
+    std::size_t device_bytes = 0;
+    int frames = 0;
+    std::string stop_condition;  // "steps N" or "time T s"
+};
+
+void write_summary(const std::string& path, const RunSummary& summary, const StatsTable& stats, const Scene& scene);
+
+}  // namespace mw

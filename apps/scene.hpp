@@ -1,0 +1,59 @@
+// Scenes: JSON in, a validated Scene out. Every key is checked against the schema (docs/scenes.md):
+// an unknown key, a wrong type or an out-of-range value throws InputError naming the full key path
+// (for example `solver.eta` or `fluid_blocks[1].min`). `--set path.to.key=value` overrides are
+// applied to the raw JSON before validation, so they go through the same checks.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "algorithms/simulation.hpp"
+
+namespace mw {
+
+using SceneJson = nlohmann::ordered_json;  // keeps the keys in the order they were written
+
+struct FluidBlock {
+    Vec3 min{}, max{};
+    Vec3 velocity{0, 0, 0};
+};
+
+struct StaticBox {
+    Vec3 min{}, max{};
+    int layers = 1;
+};
+
+struct Scene {
+    std::string name;
+    std::string source;                  // the file it came from, or "built-in default scene"
+    SimulationParams params;             // domain, gravity, fluid, solver, ordering
+    bool walls = true;                   // boundary.walls: line the domain with static boundary particles
+    Real boundary_spacing_factor = 0.5;  // boundary spacing = factor × r0
+    int boundary_layers = 1;
+    std::vector<FluidBlock> fluid_blocks;
+    std::vector<StaticBox> static_boxes;
+    double end_time = 1.0;  // run.end_time, s
+    double fps = 30;        // output.fps: frames per simulated second
+    std::vector<std::string> formats{"vtu"};
+    SceneJson resolved;  // every key with its value, defaults filled in, overrides applied
+
+    Real boundary_spacing() const { return boundary_spacing_factor * params.fluid.spacing; }
+    bool writes_vtu() const;
+};
+
+// The built-in default scene (scenes/dam_break.json, embedded at configure time).
+const char* default_scene_text();
+
+// Loads a scene from `path` ("" = the built-in default), applies `overrides` (each "key.path=value")
+// in order, and validates. Throws InputError naming the file, key or override on any problem.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// Same, from JSON text; `source` names it in messages.
+Scene parse_scene_text(const std::string& text, const std::string& source,
+                       const std::vector<std::string>& overrides = {});
+
+// Validates an already-parsed JSON scene (no overrides).
+Scene resolve_scene(const SceneJson& raw, const std::string& source);
+
+}  // namespace mw

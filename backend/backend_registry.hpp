@@ -1,0 +1,21 @@
+// What the program was built with, and the factories that create a simulation on each backend.
+// Host-only; defined in backend/openmp/, backend/cuda/ (or backend/cuda_absent.cpp).
+#pragma once
+#include <memory>
+#include <string>
+
+#include "algorithms/simulation.hpp"
+#include "backend/errors.hpp"
+
+namespace mw {
+struct BackendInfo {
+    std::string name;
+    bool compiled = false;
+    bool available = false;     // compiled and a device is usable now
+    std::string description;    // device found, or why not
+};
+BackendInfo openmp_backend_info();
+BackendInfo cuda_backend_info();
+std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads);
+std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup);
+}  // namespace mw

@@ -1,0 +1,269 @@
+// CUDA backend: cudaMalloc'd arrays, one templated kernel for parallel_for with a block size chosen
+// once per lambda type, CUB reductions/scans/sorts on a persistent workspace (no per-call device
+// allocation), CUDA-event stage timers. Same API, name for name, as backend/openmp/backend_openmp.hpp.
+#pragma once
+#include <cuda_runtime.h>
+
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_reduce.cuh>
+#include <cub/device/device_scan.cuh>
+#include <thrust/iterator/counting_iterator.h>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "backend/config.hpp"
+#include "backend/errors.hpp"
+#include "backend/memory_ledger.hpp"
+#include "backend/reduce_ops.hpp"
+#include "backend/view.hpp"
+
+#define MW_BACKEND_BEGIN \
+    namespace mw {       \
+    inline namespace cuda {
+#define MW_BACKEND_END \
+    }                  \
+    }
+
+MW_BACKEND_BEGIN
+
+constexpr const char* kBackendName = "cuda";
+
+inline MemoryLedger& memory_ledger() {
+    static MemoryLedger ledger;
+    return ledger;
+}
+
+void set_threads(int threads);  // no effect on the GPU; kept for a uniform command line
+int thread_count();
+bool backend_available();          // a CUDA device is present and usable
+std::string device_description();  // e.g. "NVIDIA H100 80GB HBM3 (sm_90, 79.1 GiB)"
+std::int64_t device_memory_free();
+void synchronize();
+// Set MELTWATER_CUDA_SYNC=1 to synchronise and check after every launch (debug mode, as PBRT).
+bool debug_sync_enabled();
+void check_cuda(cudaError_t status, const char* what);
+void check_launch(const char* name);
+
+// Scratch memory shared by every CUB call of this backend; grows, never shrinks.
+void* cub_workspace(std::size_t bytes);
+// A small pinned host buffer for reduction results, so a reduction costs one small copy.
+void* pinned_scratch(std::size_t bytes);
+
+template <class T>
+class DeviceArray {
+   public:
+    DeviceArray() = default;
+    explicit DeviceArray(std::size_t n) { resize(n); }
+    DeviceArray(const DeviceArray&) = delete;
+    DeviceArray& operator=(const DeviceArray&) = delete;
+    DeviceArray(DeviceArray&& other) noexcept { swap(other); }
+    DeviceArray& operator=(DeviceArray&& other) noexcept {
+        swap(other);
+        return *this;
+    }
+    ~DeviceArray() { release(); }
+
+    void swap(DeviceArray& other) noexcept {
+        std::swap(ptr_, other.ptr_);
+        std::swap(size_, other.size_);
+        std::swap(capacity_, other.capacity_);
+    }
+    void resize(std::size_t n) {
+        if (n > capacity_) {
+            release();
+            const std::size_t bytes = n * sizeof(T);
+            cudaError_t status = cudaMalloc(reinterpret_cast<void**>(&ptr_), bytes);
+            if (status != cudaSuccess) {
+                (void)cudaGetLastError();
+                ptr_ = nullptr;
+                throw DeviceError("out of GPU memory allocating " + std::to_string(bytes) + " bytes (" +
+                                  std::to_string(memory_ledger().current.load()) + " bytes already held, " +
+                                  std::to_string(device_memory_free()) + " free)");
+            }
+            capacity_ = n;
+            memory_ledger().add(static_cast<std::int64_t>(bytes));
+        }
+        size_ = n;
+    }
+    void release() {
+        if (ptr_) {
+            memory_ledger().remove(static_cast<std::int64_t>(capacity_ * sizeof(T)));
+            cudaFree(ptr_);
+        }
+        ptr_ = nullptr;
+        size_ = capacity_ = 0;
+    }
+    std::size_t size() const { return size_; }
+    std::size_t bytes() const { return capacity_ * sizeof(T); }
+    bool empty() const { return size_ == 0; }
+    View<T> view() { return View<T>{ptr_, size_}; }
+    View<const T> view() const { return View<const T>{ptr_, size_}; }
+    View<const T> cview() const { return View<const T>{ptr_, size_}; }
+
+    void upload(const T* host, std::size_t n) {
+        resize(n);
+        if (n) check_cuda(cudaMemcpy(ptr_, host, n * sizeof(T), cudaMemcpyHostToDevice), "upload");
+    }
+    void upload(const std::vector<T>& host) { upload(host.data(), host.size()); }
+    void download(T* host, std::size_t n) const {
+        const std::size_t count = n < size_ ? n : size_;
+        if (count) check_cuda(cudaMemcpy(host, ptr_, count * sizeof(T), cudaMemcpyDeviceToHost), "download");
+    }
+    void download(std::vector<T>& host) const {
+        host.resize(size_);
+        download(host.data(), size_);
+    }
+    std::vector<T> to_host() const {
+        std::vector<T> host;
+        download(host);
+        return host;
+    }
+    void download_range(T* host, std::size_t first, std::size_t n) const {
+        if (n)
+            check_cuda(cudaMemcpy(host, ptr_ + first, n * sizeof(T), cudaMemcpyDeviceToHost), "download_range");
+    }
+    void fill(const T& value);
+    void copy_from(const DeviceArray& other) {
+        resize(other.size_);
+        if (size_)
+            check_cuda(cudaMemcpy(ptr_, other.ptr_, size_ * sizeof(T), cudaMemcpyDeviceToDevice), "copy_from");
+    }
+
+   private:
+    T* ptr_ = nullptr;
+    std::size_t size_ = 0;
+    std::size_t capacity_ = 0;
+};
+
+template <class F>
+__global__ void parallel_for_kernel(std::size_t n, F f) {
+    const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < n) f(i);
+}
+
+// Block size chosen once per lambda type from the occupancy calculator.
+template <class F>
+int block_size_for() {
+    static int block = [] {
+        int min_grid = 0, best = 256;
+        if (cudaOccupancyMaxPotentialBlockSize(&min_grid, &best, parallel_for_kernel<F>, 0, 0) != cudaSuccess) {
+            (void)cudaGetLastError();
+            best = 256;
+        }
+        return best;
+    }();
+    return block;
+}
+
+template <class F>
+void parallel_for(const char* name, std::size_t n, F f) {
+    if (n == 0) return;
+    const int block = block_size_for<F>();
+    const std::size_t grid = (n + block - 1) / block;
+    parallel_for_kernel<F><<<static_cast<unsigned>(grid), block>>>(n, f);
+    check_launch(name);
+}
+
+template <class T>
+void DeviceArray<T>::fill(const T& value) {
+    T* p = ptr_;
+    const T v = value;
+    parallel_for("DeviceArray::fill", size_, [=] __device__(std::size_t i) { p[i] = v; });
+}
+
+// Applies f to an index; lets CUB read f(i) through a counting iterator.
+template <class T, class F>
+struct IndexTransform {
+    F f;
+    __device__ T operator()(std::size_t i) const { return f(i); }
+};
+
+// CUB's reduction has a fixed order for a given size and device, so results are reproducible.
+template <class T, class Op, class F>
+T transform_reduce(const char* name, std::size_t n, T identity, Op op, F f) {
+    if (n == 0) return identity;
+    static DeviceArray<T> device_result(1);
+    device_result.resize(1);
+    thrust::counting_iterator<std::size_t> first(0);
+    IndexTransform<T, F> transform{f};
+    std::size_t temp_bytes = 0;
+    check_cuda(cub::DeviceReduce::TransformReduce(nullptr, temp_bytes, first, device_result.view().data(),
+                                                  static_cast<std::int64_t>(n), op, transform, identity),
+               name);
+    void* temp = cub_workspace(temp_bytes);
+    check_cuda(cub::DeviceReduce::TransformReduce(temp, temp_bytes, first, device_result.view().data(),
+                                                  static_cast<std::int64_t>(n), op, transform, identity),
+               name);
+    T* host = static_cast<T*>(pinned_scratch(sizeof(T)));
+    check_cuda(cudaMemcpy(host, device_result.view().data(), sizeof(T), cudaMemcpyDeviceToHost), name);
+    return *host;
+}
+
+template <class T>
+T exclusive_scan(const char* name, View<const T> in, View<T> out) {
+    const std::size_t n = in.size();
+    if (n == 0) return T(0);
+    T last_in{};
+    check_cuda(cudaMemcpy(&last_in, in.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
+    std::size_t temp_bytes = 0;
+    check_cuda(cub::DeviceScan::ExclusiveSum(nullptr, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n)),
+               name);
+    void* temp = cub_workspace(temp_bytes);
+    check_cuda(cub::DeviceScan::ExclusiveSum(temp, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n)),
+               name);
+    T last_out{};
+    check_cuda(cudaMemcpy(&last_out, out.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
+    return last_out + last_in;
+}
+
+void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
+                View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
+
+// Atomics are called from host/device lambdas; only the device path runs on this backend.
+#if defined(__CUDA_ARCH__)
+#define MW_DEVICE_OR_HOST(device_expr, host_expr) device_expr
+#else
+#define MW_DEVICE_OR_HOST(device_expr, host_expr) host_expr
+#endif
+MW_INLINE void atomic_add(int* address, int value) {
+    MW_DEVICE_OR_HOST(atomicAdd(address, value), __atomic_fetch_add(address, value, __ATOMIC_RELAXED));
+}
+MW_INLINE void atomic_add(unsigned* address, unsigned value) {
+    MW_DEVICE_OR_HOST(atomicAdd(address, value), __atomic_fetch_add(address, value, __ATOMIC_RELAXED));
+}
+MW_INLINE void atomic_add(float* address, float value) {
+    MW_DEVICE_OR_HOST(atomicAdd(address, value), (void)(*address += value));
+}
+MW_INLINE void atomic_add(double* address, double value) {
+    MW_DEVICE_OR_HOST(atomicAdd(address, value), (void)(*address += value));
+}
+MW_INLINE int atomic_max(int* address, int value) {
+#if defined(__CUDA_ARCH__)
+    return atomicMax(address, value);
+#else
+    int seen = __atomic_load_n(address, __ATOMIC_RELAXED);
+    while (seen < value &&
+           !__atomic_compare_exchange_n(address, &seen, value, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+    }
+    return seen;
+#endif
+}
+
+// Stage timers on CUDA events: no synchronisation until read(), once per step.
+class StageTimers {
+   public:
+    explicit StageTimers(int stage_count);
+    ~StageTimers();
+    StageTimers(const StageTimers&) = delete;
+    StageTimers& operator=(const StageTimers&) = delete;
+    void start(int stage);
+    void stop(int stage);
+    void read(double* ms_out);
+
+   private:
+    std::vector<cudaEvent_t> start_, stop_;
+    std::vector<char> used_;
+};
+
+MW_BACKEND_END

@@ -1,0 +1,24 @@
+// The CUDA instantiation of the algorithms, and its factory.
+#define MW_BACKEND_CUDA
+#include "algorithms/time_step.hpp"
+#include "backend/backend_registry.hpp"
+
+namespace mw {
+
+BackendInfo cuda_backend_info() {
+    const bool available = cuda::backend_available();
+    return BackendInfo{"cuda", true, available, available ? cuda::device_description() : "compiled, but no CUDA device found"};
+}
+
+std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup) {
+    if (!cuda::backend_available()) throw DeviceError("the CUDA backend was requested but no CUDA device was found");
+    try {
+        return std::make_unique<cuda::BackendSimulation>(setup);
+    } catch (const DeviceError& e) {
+        // Out of memory while building: say how much a particle needs, measured on the CPU layout.
+        throw DeviceError(std::string(e.what()) + "; the scene has " + std::to_string(setup.position.size()) +
+                          " particles (run 'meltwater info' for the memory estimate)");
+    }
+}
+
+}  // namespace mw

@@ -1,0 +1,9 @@
+// Linked when the CUDA backend was not compiled: the program still answers what it has.
+#include "backend/backend_registry.hpp"
+
+namespace mw {
+BackendInfo cuda_backend_info() { return BackendInfo{"cuda", false, false, "not compiled (no CUDA compiler at configure time)"}; }
+std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup&) {
+    throw DeviceError("this build has no CUDA backend (configure with a CUDA compiler, MELTWATER_CUDA=ON)");
+}
+}  // namespace mw

@@ -1,0 +1,256 @@
+// OpenMP backend: host memory, `omp parallel for`, deterministic chunked reductions and scans,
+// libstdc++'s parallel sort. The API is the same, name for name, as backend/cuda/backend_cuda.cuh.
+#pragma once
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <parallel/algorithm>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "backend/config.hpp"
+#include "backend/errors.hpp"
+#include "backend/memory_ledger.hpp"
+#include "backend/reduce_ops.hpp"
+#include "backend/view.hpp"
+
+#define MW_BACKEND_BEGIN \
+    namespace mw {       \
+    inline namespace openmp {
+#define MW_BACKEND_END \
+    }                  \
+    }
+
+MW_BACKEND_BEGIN
+
+constexpr const char* kBackendName = "openmp";
+
+inline MemoryLedger& memory_ledger() {
+    static MemoryLedger ledger;
+    return ledger;
+}
+
+void set_threads(int threads);        // 0 keeps the OpenMP default
+int thread_count();
+bool backend_available();             // always true on the CPU
+std::string device_description();     // e.g. "2 OpenMP threads on Intel Xeon ..."
+std::int64_t device_memory_free();    // physical memory available, bytes
+inline void synchronize() {}
+
+// Owning array in backend memory. Contents are uninitialised after resize (callers fill what they
+// need); copies between host and backend are explicit.
+template <class T>
+class DeviceArray {
+   public:
+    DeviceArray() = default;
+    explicit DeviceArray(std::size_t n) { resize(n); }
+    DeviceArray(const DeviceArray&) = delete;
+    DeviceArray& operator=(const DeviceArray&) = delete;
+    DeviceArray(DeviceArray&& other) noexcept { swap(other); }
+    DeviceArray& operator=(DeviceArray&& other) noexcept {
+        swap(other);
+        return *this;
+    }
+    ~DeviceArray() { release(); }
+
+    void swap(DeviceArray& other) noexcept {
+        std::swap(ptr_, other.ptr_);
+        std::swap(size_, other.size_);
+        std::swap(capacity_, other.capacity_);
+    }
+    // Grows the allocation only when needed, so a per-step resize to the same size is free.
+    void resize(std::size_t n) {
+        if (n > capacity_) {
+            release();
+            const std::size_t bytes = ((n * sizeof(T) + 63) / 64) * 64;
+            ptr_ = static_cast<T*>(std::aligned_alloc(64, bytes));
+            if (!ptr_)
+                throw DeviceError("out of host memory allocating " + std::to_string(bytes) + " bytes");
+            capacity_ = n;
+            memory_ledger().add(static_cast<std::int64_t>(capacity_ * sizeof(T)));
+        }
+        size_ = n;
+    }
+    void release() {
+        if (ptr_) {
+            memory_ledger().remove(static_cast<std::int64_t>(capacity_ * sizeof(T)));
+            std::free(ptr_);
+        }
+        ptr_ = nullptr;
+        size_ = capacity_ = 0;
+    }
+    std::size_t size() const { return size_; }
+    std::size_t bytes() const { return capacity_ * sizeof(T); }
+    bool empty() const { return size_ == 0; }
+    View<T> view() { return View<T>{ptr_, size_}; }
+    View<const T> view() const { return View<const T>{ptr_, size_}; }
+    View<const T> cview() const { return View<const T>{ptr_, size_}; }
+
+    void upload(const T* host, std::size_t n) {
+        resize(n);
+        if (n) std::memcpy(ptr_, host, n * sizeof(T));
+    }
+    void upload(const std::vector<T>& host) { upload(host.data(), host.size()); }
+    void download(T* host, std::size_t n) const {
+        if (n) std::memcpy(host, ptr_, std::min(n, size_) * sizeof(T));
+    }
+    void download(std::vector<T>& host) const {
+        host.resize(size_);
+        download(host.data(), size_);
+    }
+    std::vector<T> to_host() const {
+        std::vector<T> host;
+        download(host);
+        return host;
+    }
+    // Copies part of the array to the host (used for a handful of counters per step).
+    void download_range(T* host, std::size_t first, std::size_t n) const {
+        if (n) std::memcpy(host, ptr_ + first, n * sizeof(T));
+    }
+    void fill(const T& value) {
+        T* p = ptr_;
+        const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(size_);
+#pragma omp parallel for schedule(static)
+        for (std::ptrdiff_t i = 0; i < n; ++i) p[i] = value;
+    }
+    void copy_from(const DeviceArray& other) {
+        resize(other.size_);
+        if (size_) std::memcpy(ptr_, other.ptr_, size_ * sizeof(T));
+    }
+
+   private:
+    T* ptr_ = nullptr;
+    std::size_t size_ = 0;
+    std::size_t capacity_ = 0;
+};
+
+// f(i) for i in [0, n). `name` identifies the launch in errors and profiles.
+template <class F>
+void parallel_for(const char* /*name*/, std::size_t n, F f) {
+    const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
+}
+
+// Fixed chunking independent of the thread count keeps every reduction and scan bitwise
+// reproducible from run to run and across --threads settings.
+constexpr std::size_t kReduceChunk = 4096;
+
+template <class T>
+std::vector<T>& reduction_workspace() {
+    static thread_local std::vector<T> partials;
+    return partials;
+}
+
+// op-reduction of f(i) over [0, n), starting from `identity`.
+template <class T, class Op, class F>
+T transform_reduce(const char* /*name*/, std::size_t n, T identity, Op op, F f) {
+    const std::size_t chunks = (n + kReduceChunk - 1) / kReduceChunk;
+    std::vector<T>& partials = reduction_workspace<T>();
+    if (partials.size() < chunks) partials.resize(chunks);
+    T* part = partials.data();
+    const std::ptrdiff_t chunk_count = static_cast<std::ptrdiff_t>(chunks);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t c = 0; c < chunk_count; ++c) {
+        T acc = identity;
+        const std::size_t begin = static_cast<std::size_t>(c) * kReduceChunk;
+        const std::size_t end = std::min(n, begin + kReduceChunk);
+        for (std::size_t i = begin; i < end; ++i) acc = op(acc, f(i));
+        part[c] = acc;
+    }
+    T total = identity;
+    for (std::size_t c = 0; c < chunks; ++c) total = op(total, part[c]);
+    return total;
+}
+
+// out[i] = in[0] + ... + in[i-1]; returns the total. `out` may alias `in`.
+template <class T>
+T exclusive_scan(const char* /*name*/, View<const T> in, View<T> out) {
+    const std::size_t n = in.size();
+    const std::size_t chunks = (n + kReduceChunk - 1) / kReduceChunk;
+    std::vector<T>& partials = reduction_workspace<T>();
+    if (partials.size() < chunks + 1) partials.resize(chunks + 1);
+    T* part = partials.data();
+    const std::ptrdiff_t chunk_count = static_cast<std::ptrdiff_t>(chunks);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t c = 0; c < chunk_count; ++c) {
+        T acc = T(0);
+        const std::size_t begin = static_cast<std::size_t>(c) * kReduceChunk;
+        const std::size_t end = std::min(n, begin + kReduceChunk);
+        for (std::size_t i = begin; i < end; ++i) acc += in[i];
+        part[c] = acc;
+    }
+    T running = T(0);
+    for (std::size_t c = 0; c < chunks; ++c) {
+        T chunk_sum = part[c];
+        part[c] = running;
+        running += chunk_sum;
+    }
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t c = 0; c < chunk_count; ++c) {
+        T acc = part[c];
+        const std::size_t begin = static_cast<std::size_t>(c) * kReduceChunk;
+        const std::size_t end = std::min(n, begin + kReduceChunk);
+        for (std::size_t i = begin; i < end; ++i) {
+            T value = in[i];
+            out[i] = acc;
+            acc += value;
+        }
+    }
+    return running;
+}
+
+// Sorts (key, value) pairs by key, stably. Only the low `key_bits` bits of the keys are used by
+// the GPU radix sort; here the full key is compared (same order for keys below 2^key_bits).
+// Values are particle indices, so packing key and value into one 64-bit word gives unique words
+// whose sorted order is the stable order, whatever the sort algorithm.
+void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
+                View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
+
+MW_INLINE void atomic_add(int* address, int value) { __atomic_fetch_add(address, value, __ATOMIC_RELAXED); }
+MW_INLINE void atomic_add(unsigned* address, unsigned value) {
+    __atomic_fetch_add(address, value, __ATOMIC_RELAXED);
+}
+MW_INLINE void atomic_add(float* address, float value) {
+#pragma omp atomic
+    *address += value;
+}
+MW_INLINE void atomic_add(double* address, double value) {
+#pragma omp atomic
+    *address += value;
+}
+MW_INLINE int atomic_max(int* address, int value) {
+    int seen = __atomic_load_n(address, __ATOMIC_RELAXED);
+    while (seen < value &&
+           !__atomic_compare_exchange_n(address, &seen, value, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+    }
+    return seen;
+}
+
+// Per-stage wall-clock timers. A stage is started and stopped at most once per step; read()
+// returns each stage's milliseconds for the step and clears them.
+class StageTimers {
+   public:
+    explicit StageTimers(int stage_count) : start_(stage_count), elapsed_ms_(stage_count, 0.0) {}
+    void start(int stage) { start_[stage] = std::chrono::steady_clock::now(); }
+    void stop(int stage) {
+        elapsed_ms_[stage] +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_[stage]).count();
+    }
+    void read(double* ms_out) {
+        for (std::size_t s = 0; s < elapsed_ms_.size(); ++s) {
+            ms_out[s] = elapsed_ms_[s];
+            elapsed_ms_[s] = 0.0;
+        }
+    }
+
+   private:
+    std::vector<std::chrono::steady_clock::time_point> start_;
+    std::vector<double> elapsed_ms_;
+};
+
+MW_BACKEND_END

@@ -1,0 +1,17 @@
+// The OpenMP instantiation of the algorithms, and its factory.
+#define MW_BACKEND_OPENMP
+#include "algorithms/time_step.hpp"
+#include "backend/backend_registry.hpp"
+
+namespace mw {
+
+BackendInfo openmp_backend_info() {
+    return BackendInfo{"openmp", true, true, openmp::device_description()};
+}
+
+std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads) {
+    openmp::set_threads(threads);
+    return std::make_unique<openmp::BackendSimulation>(setup);
+}
+
+}  // namespace mw

@@ -1,0 +1,28 @@
+// Particles for axis-aligned boxes: fluid blocks on a lattice, and Akinci boundary layers for the
+// domain container and for static boxes. (Meshes go through the Embree sampler instead.)
+#pragma once
+#include <vector>
+
+#include "algorithms/vec3.hpp"
+
+namespace mw {
+
+// Fluid lattice filling [lo, hi]: points lo + (i + 1/2) r0, so a block touching a wall starts
+// r0/2 from it. Throws InputError if the box is empty or inverted.
+std::vector<Vec3> fill_box_lattice(Vec3 lo, Vec3 hi, Real spacing);
+
+// Boundary particles lining a container [lo, hi]: the first layer `gap` outside the faces,
+// further layers `spacing` apart beyond it. The gap matters: with a single Akinci layer, a fluid
+// layer half a fluid spacing r0 from the wall has 55% too much density (cubic spline, h = 2 r0),
+// one r0 away 6% too much, and 1.1 r0 away the rest density (computed for a lattice against a
+// plane sampled at r0/2 or r0). Fluid blocks start r0/2 inside the faces, so the first wall layer
+// belongs kWallGap r0 outside them: the fluid then starts at rest. A negative gap means
+// kWallGap times twice the boundary spacing (the default boundary spacing is r0/2).
+constexpr Real kWallGap = Real(0.6);
+std::vector<Vec3> sample_container_walls(Vec3 lo, Vec3 hi, Real spacing, int layers, Real gap = -1);
+
+// Boundary particles of a solid static box [lo, hi]: the first layer on its faces, further layers
+// `spacing` apart inside it.
+std::vector<Vec3> sample_solid_box(Vec3 lo, Vec3 hi, Real spacing, int layers);
+
+}  // namespace mw

@@ -1,0 +1,304 @@
+#include "sampling/inside_outside.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <embree3/rtcore.h>
+#include <omp.h>
+
+#include "sampling/winding_number.hpp"
+
+namespace mw {
+
+namespace {
+
+struct Crossing {
+    double t;
+    int sign;
+};
+
+struct RawHit {
+    float t;
+    unsigned prim;
+};
+
+// RTCIntersectContext must be the first member: the filter gets a pointer to it.
+struct HitCollector {
+    RTCIntersectContext context;
+    std::vector<RawHit>* hits;
+};
+
+void collect_all_hits(const RTCFilterFunctionNArguments* args) {
+    HitCollector* collector = reinterpret_cast<HitCollector*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        collector->hits->push_back({RTCRayN_tfar(args->ray, args->N, i), RTCHitN_primID(args->hit, args->N, i)});
+        args->valid[i] = 0;  // reject, so traversal goes on and reports every hit
+    }
+}
+
+// An Embree device and scene over one mesh. Vertices are stored as floats relative to the
+// bounding-box centre so that meshes far from the origin keep their precision.
+class EmbreeScene {
+public:
+    explicit EmbreeScene(const TriangleMesh& mesh) {
+        center_ = bounding_box(mesh).center();
+        device_ = rtcNewDevice("verbose=0");
+        if (!device_) throw std::runtime_error("Embree: cannot create a device");
+        scene_ = rtcNewScene(device_);
+        rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+        rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
+        RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        float* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), mesh.vertices.size()));
+        for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+            const Vec3d p = mesh.vertices[i] - center_;
+            v[3 * i] = float(p.x());
+            v[3 * i + 1] = float(p.y());
+            v[3 * i + 2] = float(p.z());
+        }
+        unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                       3 * sizeof(unsigned), mesh.triangles.size()));
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) idx[3 * t + k] = static_cast<unsigned>(mesh.triangles[t][k]);
+        rtcSetGeometryIntersectFilterFunction(geom, collect_all_hits);
+        rtcCommitGeometry(geom);
+        rtcAttachGeometry(scene_, geom);
+        rtcReleaseGeometry(geom);
+        rtcCommitScene(scene_);
+        if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) {
+            release();
+            throw std::runtime_error("Embree: building the scene failed");
+        }
+        normals_.resize(mesh.triangles.size());
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t) normals_[t] = triangle_normal(mesh, t);
+        const Vec3d e = bounding_box(mesh).extent();
+        reach_ = e.norm() + 1e-9;
+    }
+    ~EmbreeScene() { release(); }
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+    double reach() const { return reach_; }
+
+    // Casts the infinite line through `through` along unit `dir`, starting `back` before it, and
+    // returns its surface crossings (t measured from the start) with merged duplicate hits.
+    void cast_line(const Vec3d& through, const Vec3d& dir, double back, bool parity, std::vector<RawHit>& hits,
+                   std::vector<Crossing>& out) const {
+        hits.clear();
+        out.clear();
+        const Vec3d org = through - center_ - back * dir;
+        RTCRayHit rh;
+        rh.ray.org_x = float(org.x());
+        rh.ray.org_y = float(org.y());
+        rh.ray.org_z = float(org.z());
+        rh.ray.dir_x = float(dir.x());
+        rh.ray.dir_y = float(dir.y());
+        rh.ray.dir_z = float(dir.z());
+        rh.ray.tnear = 0.f;
+        rh.ray.tfar = std::numeric_limits<float>::infinity();
+        rh.ray.time = 0.f;
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.ray.id = 0;
+        rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        HitCollector collector;
+        rtcInitIntersectContext(&collector.context);
+        collector.hits = &hits;
+        rtcIntersect1(scene_, &collector.context, &rh);
+        if (hits.empty()) return;
+        // Order by t, then drop repeated reports of one triangle (a BVH may list it twice).
+        std::sort(hits.begin(), hits.end(), [](const RawHit& a, const RawHit& b) {
+            return a.t < b.t || (a.t == b.t && a.prim < b.prim);
+        });
+        const double eps = 1e-6 * reach_;
+        std::size_t i = 0;
+        while (i < hits.size()) {
+            // Group hits within eps of the first: one crossing of an edge or vertex.
+            std::size_t j = i;
+            int sum = 0;
+            while (j < hits.size() && double(hits[j].t) - double(hits[i].t) <= eps) {
+                bool repeated = false;
+                for (std::size_t k = i; k < j; ++k) repeated = repeated || hits[k].prim == hits[j].prim;
+                if (!repeated) {
+                    const double c = normals_[hits[j].prim].dot(dir);
+                    sum += c > 0 ? 1 : (c < 0 ? -1 : 0);
+                }
+                ++j;
+            }
+            const double t = 0.5 * (double(hits[i].t) + double(hits[j - 1].t));
+            if (parity)
+                out.push_back({t, 1});
+            else if (sum != 0)
+                out.push_back({t, sum > 0 ? 1 : -1});
+            i = j;
+        }
+    }
+
+private:
+    void release() {
+        if (scene_) rtcReleaseScene(scene_);
+        if (device_) rtcReleaseDevice(device_);
+        scene_ = nullptr;
+        device_ = nullptr;
+    }
+    RTCDevice device_ = nullptr;
+    RTCScene scene_ = nullptr;
+    Vec3d center_;
+    std::vector<Vec3d> normals_;
+    double reach_ = 1;
+};
+
+// Lattice line directions: axes, body diagonals, face diagonals (one per opposite pair).
+const int kFamilies[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {1, 1, 1},  {1, 1, -1}, {1, -1, 1}, {-1, 1, 1},
+                              {1, 1, 0},  {1, -1, 0}, {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}};
+
+int resolve_families(int requested, bool closed) {
+    if (requested == 0) return closed ? 3 : 13;
+    if (requested <= 3) return 3;
+    if (requested <= 7) return 7;
+    return 13;
+}
+
+}  // namespace
+
+InsideOutsideResult classify_lattice(const TriangleMesh& mesh, const LatticeGrid& grid, const InsideOutsideOptions& options) {
+    InsideOutsideResult result;
+    const EdgeReport edges = edge_report(mesh);
+    result.parity = !edges.consistently_oriented();
+    result.directions_used = resolve_families(options.directions, edges.closed());
+    const auto t0 = std::chrono::steady_clock::now();
+    EmbreeScene scene(mesh);
+    result.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    const std::size_t n = grid.count();
+    std::vector<std::int16_t> votes(n, 0);    // sum of winding samples
+    std::vector<std::uint8_t> positive(n, 0);  // samples saying "inside"
+    const double back = scene.reach() + grid.spacing;
+    std::size_t rays = 0;
+    for (int f = 0; f < result.directions_used; ++f) {
+        const int dx = kFamilies[f][0], dy = kFamilies[f][1], dz = kFamilies[f][2];
+        const Vec3d dir = Vec3d(dx, dy, dz).normalized();
+        const double step = grid.spacing * std::sqrt(double(dx * dx + dy * dy + dz * dz));
+        // Lines start at lattice points whose predecessor along d lies outside the grid.
+        std::vector<std::array<int, 3>> starts;
+        for (int k = 0; k < grid.dims[2]; ++k)
+            for (int j = 0; j < grid.dims[1]; ++j)
+                for (int i = 0; i < grid.dims[0]; ++i)
+                    if (!grid.contains(i - dx, j - dy, k - dz)) starts.push_back({i, j, k});
+        rays += starts.size();
+#pragma omp parallel
+        {
+            std::vector<RawHit> hits;
+            std::vector<Crossing> crossings;
+#pragma omp for schedule(dynamic, 16)
+            for (long s = 0; s < static_cast<long>(starts.size()); ++s) {
+                const auto p0 = starts[static_cast<std::size_t>(s)];
+                scene.cast_line(grid.position(p0[0], p0[1], p0[2]), dir, back, result.parity, hits, crossings);
+                int total = 0;
+                for (const Crossing& c : crossings) total += c.sign;
+                int before = 0;
+                std::size_t c = 0;
+                int i = p0[0], j = p0[1], k = p0[2];
+                for (int m = 0; grid.contains(i, j, k); ++m, i += dx, j += dy, k += dz) {
+                    const double t = back + m * step;
+                    while (c < crossings.size() && crossings[c].t < t) before += crossings[c++].sign;
+                    int w_plus = total - before, w_minus = -before;
+                    if (result.parity) {
+                        w_plus = (total - before) & 1;
+                        w_minus = before & 1;
+                    }
+                    const std::size_t id = grid.index(i, j, k);
+                    votes[id] = static_cast<std::int16_t>(votes[id] + w_plus + w_minus);
+                    positive[id] = static_cast<std::uint8_t>(positive[id] + (w_plus > 0) + (w_minus > 0));
+                }
+            }
+        }
+    }
+    result.rays = rays;
+    const int samples = 2 * result.directions_used;
+    result.inside.resize(n);
+    std::size_t ambiguous = 0;
+    std::vector<std::size_t> undecided;
+    const bool refine = !edges.closed() && !result.parity && options.refine_band > 0;
+    for (std::size_t id = 0; id < n; ++id) {
+        result.inside[id] = 2 * votes[id] > samples ? 1 : 0;
+        if (positive[id] != 0 && positive[id] != samples) ++ambiguous;
+        if (refine && std::abs(double(votes[id]) / samples - 0.5) <= options.refine_band) undecided.push_back(id);
+    }
+    result.ambiguous = ambiguous;
+    if (!undecided.empty()) {
+        // Open mesh: the vote estimates the winding number to a few hundredths; where it is close
+        // to 1/2 ask the winding number itself (fast, exact near 1/2).
+        const auto t_refine = std::chrono::steady_clock::now();
+        const FastWindingNumber wn(mesh);
+        const std::size_t nx = std::size_t(grid.dims[0]), ny = std::size_t(grid.dims[1]);
+#pragma omp parallel for schedule(dynamic, 32)
+        for (long u = 0; u < static_cast<long>(undecided.size()); ++u) {
+            const std::size_t id = undecided[static_cast<std::size_t>(u)];
+            const int i = int(id % nx), j = int((id / nx) % ny), k = int(id / (nx * ny));
+            result.inside[id] = wn.evaluate_exact_near_half(grid.position(i, j, k)) > 0.5 ? 1 : 0;
+        }
+        result.refined = undecided.size();
+        result.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_refine).count();
+    }
+    return result;
+}
+
+std::vector<std::uint8_t> classify_points(const TriangleMesh& mesh, const std::vector<Vec3d>& points, int directions,
+                                          double refine_band) {
+    const EdgeReport edges = edge_report(mesh);
+    const bool parity = !edges.consistently_oriented();
+    const int families = resolve_families(directions, edges.closed());
+    EmbreeScene scene(mesh);
+    const Vec3d center = bounding_box(mesh).center();
+    const double reach0 = scene.reach() + 1e-6;
+    std::vector<std::uint8_t> inside(points.size(), 0);
+    std::unique_ptr<FastWindingNumber> wn;
+    if (!edges.closed() && !parity && refine_band > 0) wn = std::make_unique<FastWindingNumber>(mesh);
+#pragma omp parallel
+    {
+        std::vector<RawHit> hits;
+        std::vector<Crossing> crossings;
+#pragma omp for schedule(dynamic, 64)
+        for (long p = 0; p < static_cast<long>(points.size()); ++p) {
+            const Vec3d& q = points[static_cast<std::size_t>(p)];
+            int votes = 0;
+            for (int f = 0; f < families; ++f) {
+                const Vec3d dir = Vec3d(kFamilies[f][0], kFamilies[f][1], kFamilies[f][2]).normalized();
+                // Start the line far enough behind q to be outside the mesh's bounding sphere.
+                const double reach = reach0 + (q - center).norm();
+                scene.cast_line(q, dir, reach, parity, hits, crossings);
+                int total = 0, before = 0;
+                for (const Crossing& c : crossings) {
+                    total += c.sign;
+                    if (c.t < reach) before += c.sign;
+                }
+                votes += parity ? (((total - before) & 1) + (before & 1)) : (total - before) + (-before);
+            }
+            inside[static_cast<std::size_t>(p)] = votes > families ? 1 : 0;  // mean of 2F samples > 1/2
+            if (wn && std::abs(double(votes) / (2 * families) - 0.5) <= refine_band)
+                inside[static_cast<std::size_t>(p)] = wn->evaluate_exact_near_half(q) > 0.5 ? 1 : 0;
+        }
+    }
+    return inside;
+}
+
+double winding_number(const TriangleMesh& mesh, const Vec3d& p) {
+    double sum = 0;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const Vec3d a = mesh.corner(t, 0) - p, b = mesh.corner(t, 1) - p, c = mesh.corner(t, 2) - p;
+        const double la = a.norm(), lb = b.norm(), lc = c.norm();
+        const double num = a.dot(b.cross(c));
+        const double den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+        sum += 2.0 * std::atan2(num, den);
+    }
+    return sum / (4.0 * M_PI);
+}
+
+}  // namespace mw

@@ -1,0 +1,67 @@
+// Triangle meshes on the host, in double precision: the input of every sampler in sampling/.
+// A mesh is a vertex list and a triangle list (counter-clockwise seen from outside = outward
+// normal). Validation throws InputError with one line naming the source and the problem.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace mw {
+
+using Vec3d = Eigen::Vector3d;
+
+struct Aabb {
+    Vec3d lo{0, 0, 0}, hi{0, 0, 0};
+    Vec3d extent() const { return hi - lo; }
+    Vec3d center() const { return 0.5 * (lo + hi); }
+};
+
+struct TriangleMesh {
+    std::vector<Vec3d> vertices;
+    std::vector<std::array<int, 3>> triangles;
+    std::string source;  // file path or procedural description, used in error messages
+
+    std::size_t vertex_count() const { return vertices.size(); }
+    std::size_t triangle_count() const { return triangles.size(); }
+    Vec3d corner(std::size_t t, int k) const { return vertices[static_cast<std::size_t>(triangles[t][k])]; }
+};
+
+// Scale first, then rotate (Euler angles in degrees about x, then y, then z), then translate.
+struct MeshTransform {
+    Vec3d scale{1, 1, 1};
+    Vec3d rotation_deg{0, 0, 0};
+    Vec3d translation{0, 0, 0};
+    bool is_identity() const;
+};
+
+// Applies the transform in place. A mirroring scale (odd number of negative factors) also flips
+// the winding so normals stay outward. Throws InputError on a zero or non-finite scale.
+void apply_transform(TriangleMesh& mesh, const MeshTransform& transform);
+
+Aabb bounding_box(const TriangleMesh& mesh);
+// Signed volume by the divergence theorem (positive for an outward-oriented closed mesh). For an
+// open mesh it is the volume of the cone closure towards the origin, as usual.
+double signed_volume(const TriangleMesh& mesh);
+double surface_area(const TriangleMesh& mesh);
+double triangle_area(const TriangleMesh& mesh, std::size_t t);
+// Unit outward normal of triangle t (zero vector for a degenerate triangle).
+Vec3d triangle_normal(const TriangleMesh& mesh, std::size_t t);
+// Edges used by exactly one triangle (holes) and by more than two (non-manifold).
+struct EdgeReport {
+    std::size_t boundary_edges = 0;
+    std::size_t nonmanifold_edges = 0;
+    std::size_t misoriented_edges = 0;  // two triangles traverse the edge in the same direction
+    bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
+    bool consistently_oriented() const { return misoriented_edges == 0; }
+};
+EdgeReport edge_report(const TriangleMesh& mesh);
+void flip_orientation(TriangleMesh& mesh);
+
+// Checks that the mesh can be sampled: at least one triangle, finite vertices, indices in range,
+// and (when require_volume) a non-zero enclosed volume. Throws InputError "<source>: <problem>".
+void validate_mesh(const TriangleMesh& mesh, bool require_volume = true);
+
+}  // namespace mw

@@ -1,0 +1,14 @@
+// Wavefront OBJ input through tinyobjloader (polygons are triangulated; all shapes are merged
+// into one mesh; normals, texture coordinates and materials are ignored).
+#pragma once
+#include <string>
+
+#include "sampling/mesh.hpp"
+
+namespace mw {
+// Loads and validates (validate_mesh with require_volume). Throws InputError naming the file:
+// missing or unreadable file, parse error, no triangles, non-finite vertex, bad index, no volume.
+TriangleMesh load_obj(const std::string& path, bool require_volume = true);
+// The same from OBJ text (source names it in messages); used by tests.
+TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume = true);
+}  // namespace mw

@@ -1,0 +1,91 @@
+// Helpers for the command-line tests: run the real `meltwater` binary, capture its output, and
+// write small scenes into a scratch directory.
+#pragma once
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace cli_test {
+
+struct Result {
+    int code = -1;  // exit status; 128+N for a signal
+    std::string out, err;
+};
+
+// A scratch directory for this test process, removed at exit (kept when MW_KEEP_TEST_FILES is set).
+inline std::string scratch_dir() {
+    struct Scratch {
+        std::string path;
+        Scratch() {
+            const auto d = std::filesystem::temp_directory_path() / ("meltwater_cli_test_" + std::to_string(::getpid()));
+            std::filesystem::create_directories(d);
+            path = d.string();
+        }
+        ~Scratch() {
+            std::error_code ignored;
+            if (!std::getenv("MW_KEEP_TEST_FILES")) std::filesystem::remove_all(path, ignored);
+        }
+    };
+    static const Scratch scratch;
+    return scratch.path;
+}
+
+inline std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+inline void write_text(const std::string& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+// Runs `meltwater <args>` (args are pasted into a shell command line as given).
+inline Result run(const std::string& args) {
+    static int counter = 0;
+    const std::string base = scratch_dir() + "/cmd" + std::to_string(counter++);
+    const std::string command =
+        std::string("'") + MW_BINARY + "' " + args + " >'" + base + ".out' 2>'" + base + ".err' </dev/null";
+    const int status = std::system(command.c_str());
+    Result r;
+    if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
+    else if (status != -1 && WIFSIGNALED(status)) r.code = 128 + WTERMSIG(status);
+    r.out = slurp(base + ".out");
+    r.err = slurp(base + ".err");
+    return r;
+}
+
+inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+inline int count_lines(const std::string& text) {
+    int n = 0;
+    for (char c : text) n += c == '\n';
+    return n;
+}
+
+// A tiny scene (125 fluid particles in a 0.2 m box) with `extra` spliced in as more top-level keys.
+inline std::string tiny_scene_text(const std::string& extra = "") {
+    return std::string(R"({
+  "name": "tiny",
+  "domain": { "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] },
+  "fluid": { "spacing": 0.02 },
+  "solver": { "dt": 0.002 },
+  "fluid_blocks": [ { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] } ])") +
+           (extra.empty() ? "" : ",\n  " + extra) + "\n}\n";
+}
+
+// Writes a scene file into the scratch directory and returns its path.
+inline std::string scene_file(const std::string& name, const std::string& text) {
+    const std::string path = scratch_dir() + "/" + name;
+    write_text(path, text);
+    return path;
+}
+
+}  // namespace cli_test

@@ -1,0 +1,253 @@
+// The `meltwater` program end to end: bad input of every kind, info, backends, and small runs
+// whose outputs are checked (stats.csv, summary.json, frames read back with meshio).
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "cli_helpers.hpp"
+
+using namespace cli_test;
+namespace fs = std::filesystem;
+
+namespace {
+std::string tiny() {
+    static const std::string path = scene_file("tiny.json", tiny_scene_text());
+    return path;
+}
+std::string out_dir(const std::string& name) {
+    const std::string d = scratch_dir() + "/" + name;
+    fs::remove_all(d);
+    return d;
+}
+nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path)); }
+
+// One line, naming `part`, non-zero exit.
+void check_rejected(const Result& r, const std::vector<std::string>& parts, int code = 2) {
+    CAPTURE(r.err);
+    CHECK(r.code == code);
+    CHECK(contains(r.err, "meltwater: "));
+    CHECK(count_lines(r.err) == 1);
+    for (const auto& p : parts) CHECK(contains(r.err, p));
+}
+}  // namespace
+
+TEST_CASE("bad input: files") {
+    check_rejected(run("info /no/such/scene.json"), {"/no/such/scene.json", "cannot open"});
+    check_rejected(run("run /no/such/scene.json --out " + out_dir("never")), {"/no/such/scene.json"});
+    CHECK(!fs::exists(scratch_dir() + "/never"));
+    check_rejected(run("info " + scene_file("broken.json", "{ \"domain\": { \"min\": [0,0,0], }")),
+                   {"broken.json", "malformed JSON", "line 1"});
+    check_rejected(run("info " + scene_file("empty.json", "")), {"empty.json", "malformed JSON"});
+    check_rejected(run("info " + scene_file("list.json", "[1,2,3]")), {"list.json", "JSON object"});
+    check_rejected(run("info " + scratch_dir()), {"is a directory"});
+}
+
+TEST_CASE("bad input: scene keys and values") {
+    check_rejected(run("info " + scene_file("unknown.json", tiny_scene_text(R"("solverr": {})"))),
+                   {"unknown.json", "solverr", "unknown key"});
+    check_rejected(run("info " + tiny() + " --set solver.etaa=0.1"), {"solver.etaa"});
+    check_rejected(run("info " + tiny() + " --set solver.eta=2"), {"solver.eta", "(0, 1)"});
+    check_rejected(run("info " + tiny() + " --set fluid.spacing=abc"), {"fluid.spacing", "expected a number"});
+    check_rejected(run("info " + tiny() + " --set fluid.spacing=-0.01"), {"fluid.spacing", "> 0"});
+    check_rejected(run("info " + tiny() + " --set boundary.layers=2.5"), {"boundary.layers", "integer"});
+    check_rejected(run("info " + tiny() + " --set dimensions=2"), {"dimensions"});
+    check_rejected(run("info " + tiny() + " --set 'fluid_blocks.0.max=[5,5,5]'"), {"fluid_blocks[0]", "domain"});
+    check_rejected(run("info " + tiny() + " --set solver.dt_mode=sometimes"), {"solver.dt_mode", "sometimes"});
+    check_rejected(run("info " + tiny() + " --set nokey"), {"--set nokey", "KEY=VALUE"});
+    check_rejected(run("info " + scene_file("nodomain.json", R"({"fluid": {"spacing": 0.02}})")), {"domain.min"});
+}
+
+TEST_CASE("bad input: command line") {
+    check_rejected(run("frobnicate"), {"frobnicate"});
+    check_rejected(run("run " + tiny() + " --frobnicate"), {"frobnicate"});
+    check_rejected(run("run " + tiny() + " --steps 2 --time 0.1"), {"--steps", "--time"});
+    check_rejected(run("run " + tiny() + " --steps 0"), {"--steps"});
+    check_rejected(run("run " + tiny() + " --steps many"), {"many"});
+    check_rejected(run("run " + tiny() + " --time -1"), {"--time"});
+    check_rejected(run("run " + tiny() + " --threads 0"), {"--threads"});
+    check_rejected(run("run " + tiny() + " --backend vulkan"), {"--backend", "vulkan"});
+    check_rejected(run("run " + tiny() + " " + tiny()), {"one scene"});
+    check_rejected(run("run " + tiny() + " --set"), {"--set"});
+    check_rejected(run("run " + tiny() + " --steps 1 --out /proc/meltwater_cannot_write"), {"/proc/meltwater_cannot_write"});
+}
+
+TEST_CASE("--backend cuda without a usable GPU is a clear error") {
+    const Result b = run("backends --json");
+    REQUIRE(b.code == 0);
+    const auto j = nlohmann::json::parse(b.out);
+    bool cuda_available = false;
+    for (const auto& e : j["backends"])
+        if (e["name"] == "cuda") cuda_available = e["available"].get<bool>();
+    if (cuda_available) {
+        MESSAGE("a GPU is available here; the no-GPU error is not tested");
+        return;
+    }
+    check_rejected(run("run " + tiny() + " --steps 1 --backend cuda --out " + out_dir("cuda")), {"cuda"}, 3);
+}
+
+TEST_CASE("backends lists what was compiled") {
+    const Result r = run("backends");
+    CHECK(r.code == 0);
+    CHECK(contains(r.out, "openmp"));
+    CHECK(contains(r.out, "cuda"));
+    CHECK(contains(r.out, "--backend auto picks"));
+}
+
+TEST_CASE("info: the built-in default scene and a small one") {
+    const Result d = run("info");
+    CAPTURE(d.err);
+    REQUIRE(d.code == 0);
+    CHECK(contains(d.out, "dam_break"));
+    CHECK(contains(d.out, "fluid 48,000"));
+    CHECK(contains(d.out, "memory"));
+    CHECK(contains(d.out, "stages"));
+
+    const Result t = run("info " + tiny() + " --json");
+    CAPTURE(t.err);
+    REQUIRE(t.code == 0);
+    const auto j = nlohmann::json::parse(t.out);
+    CHECK(j["particles"]["fluid"] == 125);
+    CHECK(j["particles"]["static_boundary"].get<long>() > 0);
+    CHECK(j["device_bytes"].get<long>() > 0);
+    CHECK(j["stages"].size() > 0);
+    CHECK(j["scene"]["solver"]["eta"].get<double>() == doctest::Approx(0.01));
+
+    // A stage the scene does not need is not listed: viscosity off by default.
+    const Result v = run("info " + tiny() + " --json --set fluid.viscosity=0.01");
+    REQUIRE(v.code == 0);
+    const auto jv = nlohmann::json::parse(v.out);
+    CHECK(jv["stages"].size() >= j["stages"].size());
+    CHECK(jv["device_bytes"].get<long>() >= j["device_bytes"].get<long>());
+}
+
+TEST_CASE("run: two steps write frames, stats.csv and summary.json") {
+    const std::string dir = out_dir("two_steps");
+    const Result r = run("run " + tiny() + " --steps 2 --threads 1 --out " + dir + " --set solver.eta=0.02");
+    CAPTURE(r.err);
+    CAPTURE(r.out);
+    REQUIRE(r.code == 0);
+    CHECK(contains(r.out, "results in"));
+    CHECK(fs::exists(dir + "/frames/particles_00000.vtu"));
+    CHECK(fs::exists(dir + "/frames/particles.pvd"));
+
+    const std::string csv = slurp(dir + "/stats.csv");
+    const std::string header = csv.substr(0, csv.find('\n'));
+    for (const char* column : {"step", "time", "dt", "iterations", "density_error_avg", "density_error_max",
+                               "max_speed", "kinetic_energy", "lost_particles", "ms_total"})
+        CHECK(contains("," + header + ",", std::string(",") + column + ","));
+    CHECK(contains(header, ",ms_"));
+    CHECK(count_lines(csv) == 3);  // header + one row per step
+
+    const auto s = read_json(dir + "/summary.json");
+    for (const char* key : {"status", "backend", "device", "steps", "particles", "ms_per_step", "density_error",
+                            "bytes_per_particle", "scene", "lost_particles", "simulated_time", "wall_seconds",
+                            "particle_steps_per_second", "iterations"})
+        CHECK_MESSAGE(s.contains(key), key);
+    CHECK(s["status"] == "completed");
+    CHECK(s["backend"] == "openmp");
+    CHECK(s["steps"] == 2);
+    CHECK(s["particles"]["fluid"] == 125);
+    CHECK(s["ms_per_step"].contains("total"));
+    CHECK(s["density_error"].contains("avg"));
+    CHECK(s["density_error"].contains("max"));
+    CHECK(s["scene"]["solver"]["eta"].get<double>() == doctest::Approx(0.02));  // override applied
+    CHECK(s["scene"]["fluid"]["support_radius"].get<double>() == doctest::Approx(0.04));  // default filled in
+    for (const auto& entry : fs::directory_iterator(dir)) CHECK(!contains(entry.path().string(), ".tmp"));
+}
+
+TEST_CASE("run: frames every 1/fps of simulated time, none with formats []") {
+    const std::string dir = out_dir("cadence");
+    // dt 0.002, fps 250: frames at t = 0, 0.004, 0.008 over --time 0.008.
+    const Result r = run("run " + tiny() + " --time 0.008 --quiet --out " + dir + " --set output.fps=250");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(!contains(r.err, "ms/step"));  // --quiet: no progress, only errors and warnings
+    CHECK(!contains(r.err, "output in"));
+    CHECK(fs::exists(dir + "/frames/particles_00002.vtu"));
+    CHECK(!fs::exists(dir + "/frames/particles_00003.vtu"));
+    CHECK(read_json(dir + "/summary.json")["steps"] == 4);
+
+    const std::string none = out_dir("noframes");
+    const Result n = run("run " + tiny() + " --steps 1 --quiet --out " + none + " --set 'output.formats=[]'");
+    REQUIRE(n.code == 0);
+    CHECK(!fs::exists(none + "/frames/particles_00000.vtu"));
+    CHECK(fs::exists(none + "/summary.json"));
+}
+
+TEST_CASE("run: plain progress lines when stderr is not a terminal") {
+    const std::string dir = out_dir("progress");
+    const Result r = run("run " + tiny() + " --steps 10 --out " + dir + " --set 'output.formats=[]'");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(contains(r.err, "100%"));
+    CHECK(contains(r.err, "ms/step"));
+    CHECK(!contains(r.err, "\r"));
+}
+
+TEST_CASE("a frame reads back with meshio") {
+    // Debian's meshio lives under /usr/bin/python3, which another python3 on PATH may hide.
+    std::string python;
+    for (const char* candidate : {"/usr/bin/python3", "python3"})
+        if (python.empty() && std::system((std::string(candidate) + " -c 'import meshio' >/dev/null 2>&1").c_str()) == 0)
+            python = candidate;
+    if (python.empty()) {
+        MESSAGE("python3 or meshio is missing: skipped (apt install python3-meshio)");
+        return;
+    }
+    const std::string dir = out_dir("meshio");
+    REQUIRE(run("run " + tiny() + " --steps 1 --quiet --out " + dir).code == 0);
+    const std::string script = scratch_dir() + "/read_frame.py";
+    write_text(script,
+               "import sys, meshio\n"
+               "m = meshio.read(sys.argv[1])\n"
+               "n = len(m.points)\n"
+               "assert n > 125, n\n"
+               "for name in ('velocity', 'density', 'pressure', 'type', 'object'):\n"
+               "    assert name in m.point_data, name\n"
+               "    assert len(m.point_data[name]) == n, name\n"
+               "assert m.point_data['velocity'].shape == (n, 3)\n"
+               "assert (m.point_data['type'].ravel() == 0).sum() == 125\n"
+               "assert set(m.point_data['type'].ravel().tolist()) <= {0, 1, 2, 3, 4}\n"
+               "print('ok', n)\n");
+    const std::string log = scratch_dir() + "/meshio.log";
+    const int status = std::system((python + " '" + script + "' '" + dir + "/frames/particles_00000.vtu' >'" + log +
+                                    "' 2>&1")
+                                       .c_str());
+    CAPTURE(slurp(log));
+    CHECK(status == 0);
+    CHECK(contains(slurp(log), "ok"));
+}
+
+TEST_CASE("guards: a blow-up stops the run naming the step, keeping frame 0 and a failed summary") {
+    const std::string dir = out_dir("nan");
+    // An absurd rest density overflows the float pressure on the first step.
+    const Result r = run("run " + tiny() + " --steps 5 --out " + dir + " --set fluid.rest_density=1e38");
+    CAPTURE(r.err);
+    if (r.code == 0) {
+        WARN_MESSAGE(false, "the solver did not detect the blow-up (no NaN/inf produced?)");
+        return;
+    }
+    CHECK(r.code == 4);
+    CHECK(contains(r.err, "step"));
+    CHECK(contains(r.err, "particle"));
+    CHECK(contains(r.err, "kept in"));
+    CHECK(fs::exists(dir + "/frames/particles_00000.vtu"));
+    CHECK(!fs::exists(dir + "/frames/particles_00001.vtu"));
+    const auto s = read_json(dir + "/summary.json");
+    CHECK(s["status"] == "failed");
+    CHECK(s.contains("error"));
+    CHECK(fs::exists(dir + "/stats.csv"));
+}
+
+TEST_CASE("guards: particles leaving an open domain are counted and reported") {
+    const std::string dir = out_dir("lost");
+    const Result r = run("run " + tiny() + " --steps 3 --out " + dir +
+                         " --set boundary.walls=false --set 'fluid_blocks.0.velocity=[0,-20,0]' --set 'output.formats=[]'");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    const auto s = read_json(dir + "/summary.json");
+    CHECK(s["lost_particles"].get<long>() > 0);
+    CHECK(contains(r.err, "left the domain"));
+}

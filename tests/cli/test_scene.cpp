@@ -1,0 +1,177 @@
+// The scene parser in-process: defaults, resolution, overrides and every kind of bad input.
+#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+#include <doctest/doctest.h>
+
+#include "apps/scene.hpp"
+#include "apps/scene_builder.hpp"
+#include "backend/errors.hpp"
+#include "cli_helpers.hpp"
+
+using namespace mw;
+using cli_test::contains;
+using cli_test::tiny_scene_text;
+
+namespace {
+// The one-line message of the InputError that parsing `text` with `overrides` throws ("" if none).
+std::string parse_error(const std::string& text, const std::vector<std::string>& overrides = {}) {
+    try {
+        parse_scene_text(text, "test.json", overrides);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+}  // namespace
+
+TEST_CASE("the built-in default scene resolves to a ~50k particle dam break") {
+    const Scene s = load_scene("");
+    CHECK(s.name == "dam_break");
+    CHECK(s.source == "built-in default scene");
+    const SimulationSetup setup = build_setup(s);
+    const ParticleCounts c = count_particles(setup);
+    CHECK(c.by_type[kFluid] >= 40000);
+    CHECK(c.by_type[kFluid] <= 60000);
+    CHECK(c.by_type[kStaticBoundary] > 0);
+    CHECK(setup.position.size() == setup.velocity.size());
+    CHECK(setup.position.size() == setup.type.size());
+    CHECK(setup.position.size() == setup.object.size());
+}
+
+TEST_CASE("the shipped scenes resolve") {
+    for (const char* name : {"dam_break.json", "splishsplash_block.json", "hydrostatic_column.json"}) {
+        CAPTURE(name);
+        const Scene s = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/" + name);
+        CHECK(!s.name.empty());
+    }
+    const Scene block = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/splishsplash_block.json");
+    CHECK(count_particles(build_setup(block)).by_type[kFluid] == 6859);
+}
+
+TEST_CASE("defaults are filled in and recorded in the resolved scene") {
+    const Scene s = parse_scene_text(tiny_scene_text(), "t");
+    CHECK(s.params.fluid.rest_density == doctest::Approx(1000));
+    CHECK(s.params.fluid.support_radius == doctest::Approx(0.04));
+    CHECK(s.params.fluid.viscosity == 0);
+    CHECK(s.params.gravity.y == doctest::Approx(-9.81));
+    CHECK(s.params.solver.dt_mode == TimeStepMode::kFixed);
+    CHECK(s.params.solver.eta == doctest::Approx(0.01));
+    CHECK(s.params.solver.min_iterations == 3);
+    CHECK(s.params.solver.max_iterations == 100);
+    CHECK(s.params.ordering == CellOrdering::kZOrder);
+    CHECK(s.boundary_spacing_factor == doctest::Approx(0.5));
+    CHECK(s.boundary_layers == 1);
+    CHECK(s.end_time == doctest::Approx(1.0));
+    CHECK(s.fps == doctest::Approx(30));
+    REQUIRE(s.formats.size() == 1);
+    CHECK(s.formats[0] == "vtu");
+    const SceneJson& r = s.resolved;
+    CHECK(r["dimensions"] == 3);
+    CHECK(r["fluid"]["support_radius"].get<double>() == doctest::Approx(0.04));
+    CHECK(r["gravity"][1].get<double>() == doctest::Approx(-9.81));
+    CHECK(r["solver"]["dt_mode"] == "fixed");
+    CHECK(r["neighbors"]["ordering"] == "zorder");
+    CHECK(r["fluid_blocks"][0]["velocity"].size() == 3);
+    CHECK(r["run"]["end_time"].get<double>() == doctest::Approx(1.0));
+    CHECK(r["output"]["formats"][0] == "vtu");
+    CHECK(r["static_boxes"].is_array());
+    // Resolving the resolved scene gives the same scene.
+    CHECK(resolve_scene(r, "again").resolved == r);
+}
+
+TEST_CASE("--set overrides reach every kind of key") {
+    const Scene s = parse_scene_text(tiny_scene_text(), "t",
+                                     {"solver.eta=0.005", "solver.dt_mode=cfl", "gravity=[0,-1,0]",
+                                      "fluid_blocks.0.velocity=[1,0,0]", "fluid_blocks[0].max=[0.1,0.12,0.1]",
+                                      "output.formats=[]", "name=renamed", "neighbors.ordering=\"linear\"",
+                                      "static_boxes=[{\"min\":[0.15,0,0.15],\"max\":[0.2,0.05,0.2]}]",
+                                      "static_boxes.0.layers=2"});
+    CHECK(s.params.solver.eta == doctest::Approx(0.005));
+    CHECK(s.params.solver.dt_mode == TimeStepMode::kCfl);
+    CHECK(s.params.gravity.y == doctest::Approx(-1));
+    CHECK(s.fluid_blocks[0].velocity.x == doctest::Approx(1));
+    CHECK(s.fluid_blocks[0].max.y == doctest::Approx(0.12));
+    CHECK(s.formats.empty());
+    CHECK(s.name == "renamed");
+    CHECK(s.params.ordering == CellOrdering::kLinear);
+    REQUIRE(s.static_boxes.size() == 1);
+    CHECK(s.static_boxes[0].layers == 2);
+    CHECK(s.resolved["solver"]["eta"].get<double>() == doctest::Approx(0.005));
+    // A derived default follows its base when not given explicitly.
+    const Scene t = parse_scene_text(tiny_scene_text(), "t", {"fluid.spacing=0.01"});
+    CHECK(t.params.fluid.support_radius == doctest::Approx(0.02));
+}
+
+TEST_CASE("bad scenes give one line naming the key") {
+    struct Case {
+        const char* what;
+        std::string text;
+        std::vector<std::string> overrides;
+        std::vector<std::string> expect;  // every part must be in the message
+    };
+    const std::string tiny = tiny_scene_text();
+    const std::vector<Case> cases = {
+        {"malformed JSON", "{ \"domain\": ", {}, {"test.json", "malformed JSON", "line"}},
+        {"not an object", "[1, 2]", {}, {"test.json", "JSON object"}},
+        {"unknown top-level key", tiny_scene_text("\"fluids\": {}"), {}, {"fluids", "unknown key"}},
+        {"unknown nested key", tiny_scene_text("\"output\": {\"fsp\": 3}"), {}, {"output.fsp", "unknown key"}},
+        {"unknown key in an array element", tiny, {"fluid_blocks=[{\"min\":[0,0,0],\"max\":[0.1,0.1,0.1],\"vel\":[0,0,0]}]"},
+         {"fluid_blocks[0].vel", "unknown key"}},
+        {"missing domain", "{\"fluid\": {\"spacing\": 0.02}}", {}, {"domain.min", "required"}},
+        {"missing spacing", tiny, {"fluid={}"}, {"fluid.spacing", "required"}},
+        {"wrong type (string for number)", tiny, {"solver.dt=abc"}, {"solver.dt", "expected a number"}},
+        {"wrong type (number for section)", tiny, {"solver=3"}, {"solver", "expected an object"}},
+        {"wrong type (vector)", tiny, {"gravity=[0,1]"}, {"gravity", "3 numbers"}},
+        {"wrong type (bool)", tiny, {"boundary.walls=3"}, {"boundary.walls", "true or false"}},
+        {"eta out of range", tiny, {"solver.eta=1.5"}, {"solver.eta", "(0, 1)", "1.5"}},
+        {"negative viscosity", tiny, {"fluid.viscosity=-1"}, {"fluid.viscosity", ">= 0"}},
+        {"support radius too small", tiny, {"fluid.support_radius=0.01"}, {"fluid.support_radius", "(0.02, 0.08]"}},
+        {"support radius too large", tiny, {"fluid.support_radius=0.2"}, {"fluid.support_radius"}},
+        {"non-integer", tiny, {"boundary.layers=1.5"}, {"boundary.layers", "integer"}},
+        {"layers out of range", tiny, {"boundary.layers=9"}, {"boundary.layers", "[1, 8]"}},
+        {"iterations inverted", tiny, {"solver.max_iterations=2"}, {"solver.max_iterations", "min_iterations"}},
+        {"bad choice", tiny, {"solver.dt_mode=adaptive"}, {"solver.dt_mode", "fixed, cfl", "adaptive"}},
+        {"bad format", tiny, {"output.formats=[\"obj\"]"}, {"output.formats[0]", "vtu"}},
+        {"2D", tiny, {"dimensions=2"}, {"dimensions", "only 3"}},
+        {"inverted domain", tiny, {"domain.max=[0.2,-1,0.2]"}, {"domain.max", "exceed min"}},
+        {"block outside the domain", tiny, {"fluid_blocks.0.max=[0.1,0.5,0.1]"}, {"fluid_blocks[0]", "inside the domain"}},
+        {"no fluid", tiny, {"fluid_blocks=[]"}, {"fluid_blocks", "at least one"}},
+        {"zero fps", tiny, {"output.fps=0"}, {"output.fps"}},
+        {"--set unknown key", tiny, {"solver.etaa=0.1"}, {"--set solver.etaa", "no such key"}},
+        {"--set unknown section", tiny, {"solvers.eta=0.1"}, {"--set solvers.eta", "no such key"}},
+        {"--set bad index", tiny, {"fluid_blocks.3.min=[0,0,0]"}, {"fluid_blocks", "index"}},
+        {"--set without =", tiny, {"solver.eta"}, {"--set solver.eta", "KEY=VALUE"}},
+        {"--set into a value", tiny, {"solver.eta.x=1"}, {"--set solver.eta.x"}},
+    };
+    for (const Case& c : cases) {
+        CAPTURE(c.what);
+        const std::string message = parse_error(c.text, c.overrides);
+        CAPTURE(message);
+        CHECK(!message.empty());
+        CHECK(message.find('\n') == std::string::npos);
+        for (const auto& part : c.expect) CHECK(contains(message, part));
+    }
+}
+
+TEST_CASE("a scene too large to build is refused before allocating") {
+    const Scene s = parse_scene_text(tiny_scene_text(), "t", {"domain.max=[1000,1000,1000]", "fluid.spacing=0.001"});
+    CHECK_THROWS_AS(build_setup(s), InputError);
+}
+
+TEST_CASE("the setup has fluid first, walls and static boxes with their object ids") {
+    const Scene s = parse_scene_text(
+        tiny_scene_text(R"("static_boxes": [ { "min": [0.15, 0, 0.15], "max": [0.2, 0.05, 0.2] } ])"), "t");
+    const SimulationSetup setup = build_setup(s);
+    const ParticleCounts c = count_particles(setup);
+    CHECK(c.by_type[kFluid] == 125);
+    bool has_wall = false, has_box = false;
+    for (std::size_t i = 0; i < setup.type.size(); ++i) {
+        if (setup.type[i] == kFluid) CHECK(setup.object[i] == -1);
+        if (setup.type[i] == kStaticBoundary && setup.object[i] == -1) has_wall = true;
+        if (setup.type[i] == kStaticBoundary && setup.object[i] == 0) has_box = true;
+    }
+    CHECK(has_wall);
+    CHECK(has_box);
+    CHECK(estimate_particle_count(s) > 0);
+    const Scene open = parse_scene_text(tiny_scene_text(), "t", {"boundary.walls=false"});
+    CHECK(count_particles(build_setup(open)).by_type[kStaticBoundary] == 0);
+}

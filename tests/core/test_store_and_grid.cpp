@@ -1,0 +1,163 @@
+// The particle store's permutation keeps particles whole; the grid finds exactly the pairs
+// nanoflann's radius search finds.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <nanoflann.hpp>
+#include <random>
+#include <set>
+
+#define MW_BACKEND_OPENMP
+#include "algorithms/neighbor_grid.hpp"
+
+using namespace mw;
+
+TEST_CASE("one permutation keeps every field of a particle together") {
+    ParticleStore store;
+    DeviceArray<double>& extra = store.add<double>("extra", FieldLife::kPersistent);
+    const std::size_t n = 5000;
+    store.resize(n, n);
+    std::vector<std::uint32_t> id(n);
+    std::vector<Vec3> pos(n), vel(n);
+    std::vector<std::uint8_t> type(n);
+    std::vector<std::int32_t> object(n);
+    std::vector<Real> density(n);
+    std::vector<double> extra_host(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        id[i] = std::uint32_t(i);
+        pos[i] = {Real(i), Real(2 * i), Real(3 * i)};
+        vel[i] = {Real(-double(i)), 0, 1};
+        type[i] = std::uint8_t(i % 5);
+        object[i] = std::int32_t(i % 17);
+        density[i] = Real(i) * 0.5f;
+        extra_host[i] = 1e6 + double(i);
+    }
+    store.id.upload(id);
+    store.position.upload(pos);
+    store.velocity.upload(vel);
+    store.type.upload(type);
+    store.object.upload(object);
+    store.density.upload(density);
+    extra.upload(extra_host);
+
+    std::vector<std::uint32_t> perm(n);
+    std::iota(perm.begin(), perm.end(), 0u);
+    std::shuffle(perm.begin(), perm.end(), std::mt19937(3));
+    DeviceArray<std::uint32_t> perm_device;
+    perm_device.upload(perm);
+    store.permute(perm_device.cview(), 0);
+
+    const auto id_after = store.id.to_host();
+    const auto pos_after = store.position.to_host();
+    const auto vel_after = store.velocity.to_host();
+    const auto type_after = store.type.to_host();
+    const auto object_after = store.object.to_host();
+    const auto density_after = store.density.to_host();
+    const auto extra_after = extra.to_host();
+    bool whole = true;
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t i = id_after[k];
+        whole &= i == perm[k];
+        whole &= pos_after[k].y == Real(2 * i) && vel_after[k].x == Real(-double(i));
+        whole &= type_after[k] == i % 5 && object_after[k] == std::int32_t(i % 17);
+        whole &= density_after[k] == Real(i) * 0.5f && extra_after[k] == 1e6 + double(i);
+    }
+    CHECK(whole);
+}
+
+namespace {
+struct Cloud {
+    const std::vector<Vec3>* points;
+    std::size_t kdtree_get_point_count() const { return points->size(); }
+    float kdtree_get_pt(std::size_t i, std::size_t d) const {
+        const Vec3& p = (*points)[i];
+        return d == 0 ? p.x : d == 1 ? p.y : p.z;
+    }
+    template <class B>
+    bool kdtree_get_bbox(B&) const { return false; }
+};
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3>;
+
+std::set<std::pair<std::uint32_t, std::uint32_t>> nanoflann_pairs(const std::vector<Vec3>& points, Real h) {
+    Cloud cloud{&points};
+    Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    tree.buildIndex();
+    std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    std::vector<std::pair<unsigned, float>> matches;
+    nanoflann::SearchParams params;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const float q[3] = {points[i].x, points[i].y, points[i].z};
+        tree.radiusSearch(q, h * h, matches, params);
+        for (const auto& m : matches)
+            if (m.first != i) pairs.insert({std::uint32_t(i), std::uint32_t(m.first)});
+    }
+    return pairs;
+}
+
+std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<Vec3>& points, Vec3 lo, Vec3 hi, Real h,
+                                                            CellOrdering ordering) {
+    ParticleStore store;
+    const std::size_t n = points.size();
+    store.resize(n, n);
+    std::vector<std::uint32_t> id(n);
+    std::iota(id.begin(), id.end(), 0u);
+    store.id.upload(id);
+    store.position.upload(points);
+    store.type.fill(kFluid);
+    NeighborGrid grid;
+    grid.configure(lo, hi, h, ordering);
+    const GroupRanges ranges = grid.build(store);
+    REQUIRE(ranges.fluid_end == n);
+    const GridView view = grid.view();
+    const auto sorted_id = store.id.to_host();
+    const auto sorted_pos = store.position.to_host();
+    std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t i = 0; i < n; ++i)
+        view.for_each_fluid(sorted_pos[i], [&](std::uint32_t j) {
+            if (j != i && norm2(sorted_pos[i] - sorted_pos[j]) < h * h) pairs.insert({sorted_id[i], sorted_id[j]});
+        });
+    return pairs;
+}
+}  // namespace
+
+TEST_CASE("grid neighbours equal nanoflann's radius search") {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> unit(0.f, 1.f);
+    const Vec3 lo{0, 0, 0}, hi{1.0f, 0.6f, 0.4f};
+    const Real h = 0.05f;
+    std::vector<Vec3> points;
+    for (int i = 0; i < 6000; ++i) points.push_back({unit(rng) * hi.x, unit(rng) * hi.y, unit(rng) * hi.z});
+    // Clusters, leaving many cells empty, and particles on the domain's faces and corners.
+    for (int c = 0; c < 4; ++c) {
+        const Vec3 centre{unit(rng) * hi.x, unit(rng) * hi.y, unit(rng) * hi.z};
+        for (int i = 0; i < 800; ++i)
+            points.push_back({std::clamp(centre.x + 0.03f * (unit(rng) - 0.5f), 0.f, hi.x),
+                              std::clamp(centre.y + 0.03f * (unit(rng) - 0.5f), 0.f, hi.y),
+                              std::clamp(centre.z + 0.03f * (unit(rng) - 0.5f), 0.f, hi.z)});
+    }
+    for (int i = 0; i < 200; ++i) {
+        points.push_back({0.f, unit(rng) * hi.y, unit(rng) * hi.z});
+        points.push_back({unit(rng) * hi.x, 0.f, hi.z * 0.999f});
+    }
+    points.push_back(lo);
+    const auto expected = nanoflann_pairs(points, h);
+    REQUIRE(expected.size() > 10000);
+    // The grid spans the domain plus one support radius, as the simulation's does.
+    const Vec3 grid_lo{-h, -h, -h}, grid_hi{hi.x + h, hi.y + h, hi.z + h};
+    CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kLinear) == expected);
+    CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kZOrder) == expected);
+}
+
+TEST_CASE("particles outside the grid are set aside, not lost silently") {
+    ParticleStore store;
+    std::vector<Vec3> points = {{0.5f, 0.5f, 0.5f}, {5.f, 0.5f, 0.5f}, {0.4f, 0.5f, 0.5f}};
+    store.resize(points.size(), points.size());
+    store.position.upload(points);
+    store.type.fill(kFluid);
+    NeighborGrid grid;
+    grid.configure({0, 0, 0}, {1, 1, 1}, 0.1f, CellOrdering::kZOrder);
+    const GroupRanges ranges = grid.build(store);
+    CHECK(ranges.fluid_end == 2);
+    CHECK(ranges.solid_end == 2);
+    CHECK(store.position.to_host()[2].x == 5.f);
+}

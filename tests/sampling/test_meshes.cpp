@@ -1,0 +1,139 @@
+// Meshes: procedural makers, transforms, OBJ loading and every kind of bad input.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "backend/errors.hpp"
+#include "sampling/mesh.hpp"
+#include "sampling/obj_loader.hpp"
+#include "sampling/procedural_meshes.hpp"
+#include "sampling_helpers.hpp"
+
+using namespace mw;
+
+namespace {
+void check_closed_outward(const TriangleMesh& m, double expected_volume, double rel_tol) {
+    const EdgeReport e = edge_report(m);
+    CHECK(e.boundary_edges == 0);
+    CHECK(e.nonmanifold_edges == 0);
+    CHECK(e.misoriented_edges == 0);
+    CHECK(signed_volume(m) == doctest::Approx(expected_volume).epsilon(rel_tol));
+    CHECK_NOTHROW(validate_mesh(m, true));
+}
+std::string error_of(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+}  // namespace
+
+TEST_CASE("procedural meshes are closed, outward and have the right volume") {
+    check_closed_outward(make_box(Vec3d(1, 2, 3)), 6.0, 1e-12);
+    check_closed_outward(make_hollow_box(Vec3d(1, 1, 1), 0.2), 1.0 - 0.6 * 0.6 * 0.6, 1e-12);
+    check_closed_outward(make_hollow_box(Vec3d(1, 1, 1), 0.2, true), 1.0 - 0.6 * 0.6 * 0.8, 1e-12);
+    check_closed_outward(make_sphere(2.0, 5), 4.0 / 3.0 * M_PI * 8.0, 2e-3);
+    check_closed_outward(make_cylinder(0.5, 2.0, 256), M_PI * 0.25 * 2.0, 1e-3);
+    check_closed_outward(make_torus(1.0, 0.25, 256, 128), 2 * M_PI * M_PI * 1.0 * 0.0625, 1e-3);
+    check_closed_outward(make_stairs(4, 1.0, 0.3, 0.2), 1.0 * 0.3 * 0.2 * (4 * 5 / 2), 1e-12);
+    const TriangleMesh sheet = make_sheet(1, 2, 4, 8);
+    CHECK(edge_report(sheet).boundary_edges == 2 * (4 + 8));
+    CHECK(surface_area(sheet) == doctest::Approx(2.0));
+    CHECK(triangle_normal(sheet, 0).y() == doctest::Approx(1.0));
+    CHECK_THROWS_AS(validate_mesh(sheet, true), InputError);  // encloses nothing
+    CHECK_NOTHROW(validate_mesh(sheet, false));
+    // Centred on the origin.
+    const Aabb b = bounding_box(make_stairs(3, 1, 1, 1));
+    CHECK(b.center().norm() < 1e-12);
+}
+
+TEST_CASE("procedural specs and their errors") {
+    const TriangleMesh s = make_procedural_from_spec("sphere:radius=0.5,subdivisions=3");
+    CHECK(s.triangles.size() == 20 * 64);
+    CHECK(bounding_box(s).extent().x() == doctest::Approx(1.0));
+    CHECK(is_procedural_spec("hollow_box:wall=0.1"));
+    CHECK_FALSE(is_procedural_spec("bunny.obj"));
+    CHECK(error_of([] { make_procedural_from_spec("pyramid"); }).find("unknown procedural mesh 'pyramid'") != std::string::npos);
+    CHECK(error_of([] { make_procedural_from_spec("box:depth=2"); }).find("unknown parameter 'depth'") != std::string::npos);
+    CHECK(error_of([] { make_procedural_from_spec("box:x=abc"); }).find("not a number") != std::string::npos);
+    CHECK(error_of([] { make_procedural_from_spec("hollow_box:wall=0.6"); }).find("wall") != std::string::npos);
+    CHECK(error_of([] { make_procedural_from_spec("sphere:radius=-1"); }).find("radius") != std::string::npos);
+}
+
+TEST_CASE("transforms scale, rotate, translate and keep the orientation outward") {
+    TriangleMesh m = make_box(Vec3d(1, 1, 1));
+    MeshTransform t;
+    t.scale = Vec3d(2, 3, 4);
+    t.rotation_deg = Vec3d(0, 0, 90);
+    t.translation = Vec3d(10, 0, 0);
+    apply_transform(m, t);
+    CHECK(signed_volume(m) == doctest::Approx(24.0));
+    const Aabb b = bounding_box(m);
+    CHECK(b.center().x() == doctest::Approx(10.0));
+    CHECK(b.extent().x() == doctest::Approx(3.0));  // y size 3 rotated onto x
+    CHECK(b.extent().y() == doctest::Approx(2.0));
+    TriangleMesh mirrored = make_box(Vec3d(1, 1, 1));
+    MeshTransform mirror;
+    mirror.scale = Vec3d(-1, 1, 1);
+    apply_transform(mirrored, mirror);
+    CHECK(signed_volume(mirrored) == doctest::Approx(1.0));
+    MeshTransform zero;
+    zero.scale = Vec3d(1, 0, 1);
+    CHECK_THROWS_AS(apply_transform(mirrored, zero), InputError);
+}
+
+TEST_CASE("OBJ input: polygons are triangulated") {
+    const std::string quad_cube =
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    const TriangleMesh m = parse_obj(quad_cube, "cube.obj");
+    CHECK(m.triangles.size() == 12);
+    CHECK(signed_volume(m) == doctest::Approx(1.0));
+    CHECK(edge_report(m).closed());
+}
+
+TEST_CASE("bad mesh input gives one clear error naming the file and the problem") {
+    const std::string tet_faces = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    CHECK(error_of([] { load_obj("/nonexistent/dir/missing.obj"); }) ==
+          "/nonexistent/dir/missing.obj: mesh file does not exist");
+    CHECK(error_of([] { load_obj(std::filesystem::temp_directory_path().string()); }).find("not a regular file") !=
+          std::string::npos);
+    CHECK(error_of([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\n", "points.obj"); }) == "points.obj: the mesh has no triangles");
+    CHECK(error_of([] { parse_obj("", "empty.obj"); }) == "empty.obj: the mesh has no triangles");
+    const std::string nan_err =
+        error_of([&] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 nan 0\nv 0 0 1\n" + tet_faces, "nan.obj"); });
+    CHECK(nan_err.rfind("nan.obj: vertex 3 is not finite", 0) == 0);
+    const std::string flat = error_of([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n", "flat.obj"); });
+    CHECK(flat.rfind("flat.obj: the mesh encloses zero volume", 0) == 0);
+    // A closed surface folded onto itself: two copies of a triangle with opposite windings.
+    const std::string folded = error_of([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 4\nf 1 4 2\n", "folded.obj"); });
+    CHECK(folded.rfind("folded.obj: the mesh encloses zero volume", 0) == 0);
+    // Out-of-range index: tinyobjloader rejects it or we do; either way the file is named.
+    const std::string bad_index = error_of([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "index.obj"); });
+    CHECK(bad_index.rfind("index.obj: ", 0) == 0);
+    // Via a real file as well (NaN written by a tool).
+    const std::string path = (std::filesystem::temp_directory_path() / "mw_sampling_nan_test.obj").string();
+    {
+        std::ofstream f(path);
+        f << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 inf\n" << tet_faces;
+    }
+    CHECK(error_of([&] { load_obj(path); }).rfind(path + ": vertex 4 is not finite", 0) == 0);
+    std::filesystem::remove(path);
+}
+
+TEST_CASE("the shared meshes load with the expected topology") {
+    if (mwtest::missing_mesh("spot.obj") || mwtest::missing_mesh("stanford-bunny.obj")) return;
+    const TriangleMesh spot = load_obj(mwtest::mesh_dir() + "/spot.obj");
+    CHECK(spot.triangles.size() == 5856);
+    CHECK(edge_report(spot).closed());
+    const TriangleMesh bunny = load_obj(mwtest::mesh_dir() + "/stanford-bunny.obj");
+    CHECK(bunny.triangles.size() == 69451);
+    CHECK(edge_report(bunny).boundary_edges == 223);
+    CHECK(signed_volume(bunny) == doctest::Approx(7.70e-4).epsilon(0.01));
+}
