@@ -39,6 +39,7 @@ struct GridShape {
     std::uint32_t cell_count = 1;
     bool zorder = false;
     int morton_bits = 0;  // bits per axis in the Z-order key
+    int reach = 1;        // cells per support radius: gathers visit (2 reach + 1)^3 cells
 
     // Cell coordinates of x; false when x is outside the grid (or not finite).
     MW_INLINE bool cell_of(Vec3 x, int c[3]) const {
@@ -83,19 +84,21 @@ struct GridView {
     const std::uint32_t* end = nullptr;
     const std::uint32_t* static_begin = nullptr;  // [cell]; null when the scene has no static boundary
     const std::uint32_t* static_end = nullptr;
+    bool has_solids = false;  // moving solid particles exist: otherwise their 27 cells are skipped
 
-    // Calls f(j) for every particle j in the 27 cells around x's cell, from the given cell
-    // ranges. The caller checks distances (it has the positions).
+    // Calls f(j) for every particle j in the cells within one support radius of x's cell (27 cells
+    // of size h, or 125 of size h/2), from the given cell ranges. The caller checks distances.
     template <class F>
     MW_INLINE void for_each_in_ranges(const std::uint32_t* first, const std::uint32_t* last, Vec3 x, F&& f) const {
         int c[3];
         shape.clamped_cell_of(x, c);
-        const int x0 = c[0] > 0 ? c[0] - 1 : 0;
-        const int x1 = c[0] + 1 < shape.dims[0] ? c[0] + 1 : shape.dims[0] - 1;
-        for (int dz = -1; dz <= 1; ++dz) {
+        const int r = shape.reach;
+        const int x0 = c[0] - r > 0 ? c[0] - r : 0;
+        const int x1 = c[0] + r < shape.dims[0] ? c[0] + r : shape.dims[0] - 1;
+        for (int dz = -r; dz <= r; ++dz) {
             const int z = c[2] + dz;
             if (z < 0 || z >= shape.dims[2]) continue;
-            for (int dy = -1; dy <= 1; ++dy) {
+            for (int dy = -r; dy <= r; ++dy) {
                 const int y = c[1] + dy;
                 if (y < 0 || y >= shape.dims[1]) continue;
                 if (!shape.zorder) {
@@ -126,11 +129,21 @@ struct GridView {
     }
     template <class F>
     MW_INLINE void for_each_solid(Vec3 x, F&& f) const {
-        for_each_in_ranges(begin + shape.cell_count, end + shape.cell_count, x, f);
+        if (has_solids) for_each_in_ranges(begin + shape.cell_count, end + shape.cell_count, x, f);
     }
     template <class F>
     MW_INLINE void for_each_static(Vec3 x, F&& f) const {
         if (static_begin) for_each_in_ranges(static_begin, static_end, x, f);
+    }
+    // The gather interface shared with NeighborListView (the grid does not need i).
+    template <class F>
+    MW_INLINE void gather_fluid(std::size_t, Vec3 x, F&& f) const {
+        for_each_fluid(x, f);
+    }
+    template <class F>
+    MW_INLINE void gather_boundary(std::size_t, Vec3 x, F&& f) const {
+        for_each_static(x, f);
+        for_each_solid(x, f);
     }
 };
 
@@ -142,8 +155,10 @@ struct GroupRanges {
 
 class NeighborGrid {
    public:
-    // Fits a grid of cells of size h over [lo, hi].
-    void configure(Vec3 lo, Vec3 hi, Real h, CellOrdering ordering) {
+    // Fits a grid of cells of size h / cells_per_h over [lo, hi].
+    void configure(Vec3 lo, Vec3 hi, Real h, CellOrdering ordering, int cells_per_h = 1) {
+        shape_.reach = cells_per_h;
+        h = h / cells_per_h;
         shape_.origin = lo;
         shape_.inv_cell = Real(1) / h;
         std::uint64_t count = 1;
@@ -178,6 +193,7 @@ class NeighborGrid {
     GridView view() const {
         GridView v;
         v.shape = shape_;
+        v.has_solids = has_solids_;
         v.begin = begin_.view().data();
         v.end = end_.view().data();
         if (!static_begin_.empty()) {
@@ -193,6 +209,7 @@ class NeighborGrid {
 
    private:
     GridShape shape_;
+    bool has_solids_ = false;  // set by build(): the solid group is non-empty
     DeviceArray<std::uint32_t> keys_, sorted_keys_, order_, sorted_order_;
     DeviceArray<std::uint32_t> begin_, end_;               // moving groups 0 and 1
     DeviceArray<std::uint32_t> static_begin_, static_end_; // static boundary
@@ -319,6 +336,7 @@ inline GroupRanges NeighborGrid::build(ParticleStore& store) {
     if (group_first[kGroupFluid] != 0) ranges.fluid_end = 0;  // no fluid at all
     ranges.solid_end = group_first[kGroupInactive];
     if (ranges.solid_end < ranges.fluid_end) ranges.solid_end = ranges.fluid_end;
+    has_solids_ = ranges.solid_end > ranges.fluid_end;
     return ranges;
 }
 

@@ -18,6 +18,7 @@ struct FluidConstants {
     Real rest_density = 0;    // ρ0
     Real mass = 0;            // fluid particle mass
     Real viscosity = 0;       // μ
+    Real wall_viscosity = 0;  // μ of the fluid–wall friction (Eq. 8 against boundary particles)
     Vec3 gravity{0, 0, 0};
 };
 
@@ -52,21 +53,34 @@ inline void compute_boundary_volumes(GridView grid, View<const Vec3> position, V
     });
 }
 
-// Non-pressure acceleration of fluid: gravity plus viscosity (the paper's Eq. 4 with the
-// Müller viscosity Laplacian, which is never negative). Densities are the previous step's.
+// Non-pressure acceleration of fluid: gravity, viscosity (the paper's Eq. 4 with the Müller
+// viscosity Laplacian, which is never negative) and friction against boundary particles (Eq. 8,
+// ψ_b = ρ0 V_b, ρ_b = ρ0: a_i += μ_w V_b/ρ0 (v_b - v_i) ∇²W). Densities are the previous step's.
 inline void compute_viscosity_acceleration(GridView grid, std::size_t fluid_count, View<const Vec3> position,
                                            View<const Vec3> velocity, View<const Real> density,
-                                           View<Vec3> acceleration, FluidConstants c) {
+                                           View<const Real> boundary_volume, View<Vec3> acceleration,
+                                           FluidConstants c) {
+    const bool walls = c.wall_viscosity > Real(0);
     parallel_for("viscosity", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i], vi = velocity[i];
-        Vec3 sum{0, 0, 0};
+        Vec3 sum{0, 0, 0}, wall_sum{0, 0, 0};
         grid.for_each_fluid(xi, [&](std::uint32_t j) {
             const Vec3 d = xi - position[j];
             const Real r2 = norm2(d);
             if (r2 >= c.support2 || j == i) return;
             sum += (c.kernel.laplacian_visc(std::sqrt(r2)) / density[j]) * (velocity[j] - vi);
         });
-        acceleration[i] = c.gravity + (c.viscosity * c.mass / density[i]) * sum;
+        if (walls) {
+            auto friction = [&](std::uint32_t b) {
+                const Real r2 = norm2(xi - position[b]);
+                if (r2 < c.support2)
+                    wall_sum += (boundary_volume[b] * c.kernel.laplacian_visc(std::sqrt(r2))) * (velocity[b] - vi);
+            };
+            grid.for_each_static(xi, friction);
+            grid.for_each_solid(xi, friction);
+        }
+        acceleration[i] = c.gravity + (c.viscosity * c.mass / density[i]) * sum +
+                          (c.wall_viscosity / c.rest_density) * wall_sum;
     });
 }
 
@@ -83,27 +97,28 @@ inline void predict_positions(std::size_t fluid_count, View<const Vec3> position
 }
 
 // Predicted density from fluid (at predicted positions) and boundary particles, then
-// p_i += δ (ρ*_i - ρ0), clamped at 0 (free-surface particle deficiency).
-inline void predict_density_and_pressure(GridView grid, std::size_t fluid_count, View<const Vec3> predicted,
-                                         View<const Vec3> position, View<const Real> boundary_volume,
-                                         View<Real> density, View<Real> pressure, FluidConstants c, Real delta) {
+// p_i += δ (ρ*_i - ρ0), clamped at 0 (free-surface particle deficiency), and p_i/ρ_i².
+template <class Neighbors>
+void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
+                                  View<const Vec3> position, View<const Real> boundary_volume, View<Real> density,
+                                  View<Real> pressure, View<Real> pressure_term, FluidConstants c, Real delta) {
     parallel_for("pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         Real fluid_sum = 0, boundary_sum = 0;
-        grid.for_each_fluid(position[i], [&](std::uint32_t j) {
+        neighbors.gather_fluid(i, position[i], [&](std::uint32_t j) {
             const Real r2 = norm2(xi - predicted[j]);
             if (r2 < c.support2) fluid_sum += c.kernel.W(std::sqrt(r2));
         });
-        auto boundary = [&](std::uint32_t b) {
+        neighbors.gather_boundary(i, position[i], [&](std::uint32_t b) {
             const Real r2 = norm2(xi - position[b]);
             if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.W(std::sqrt(r2));
-        };
-        grid.for_each_static(position[i], boundary);
-        grid.for_each_solid(position[i], boundary);
+        });
         const Real rho = c.mass * fluid_sum + c.rest_density * boundary_sum;
         density[i] = rho;
-        const Real p = pressure[i] + delta * (rho - c.rest_density);
-        pressure[i] = p > Real(0) ? p : Real(0);
+        const Real p_raw = pressure[i] + delta * (rho - c.rest_density);
+        const Real p = p_raw > Real(0) ? p_raw : Real(0);
+        pressure[i] = p;
+        pressure_term[i] = p / (rho * rho);  // p/ρ², read by every neighbour's pressure force
     });
 }
 
@@ -118,28 +133,34 @@ inline DensityError density_error(std::size_t fluid_count, View<const Real> dens
 }
 
 // a_p,i = -m Σ_j (p_i/ρ_i² + p_j/ρ_j²) ∇W(x*_ij) - Σ_b ψ_b (p_i/ρ_i²) ∇W(x*_i - x_b).
-inline void pressure_acceleration(GridView grid, std::size_t fluid_count, View<const Vec3> predicted,
-                                  View<const Vec3> position, View<const Real> boundary_volume,
-                                  View<const Real> density, View<const Real> pressure, View<Vec3> pressure_acc,
-                                  FluidConstants c) {
+template <class Neighbors>
+void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
+                           View<const Vec3> position, View<const Real> boundary_volume,
+                           View<const Real> pressure_term, View<Vec3> pressure_acc, FluidConstants c) {
     parallel_for("pcisph_pressure_force", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
-        const Real pi_rho2 = pressure[i] / (density[i] * density[i]);
+        const Real pi_rho2 = pressure_term[i];
         Vec3 fluid_sum{0, 0, 0}, boundary_sum{0, 0, 0};
-        grid.for_each_fluid(position[i], [&](std::uint32_t j) {
+        neighbors.gather_fluid(i, position[i], [&](std::uint32_t j) {
             const Vec3 d = xi - predicted[j];
             const Real r2 = norm2(d);
             if (r2 >= c.support2 || j == i) return;
-            fluid_sum += (pi_rho2 + pressure[j] / (density[j] * density[j])) * c.kernel.grad_W(d, std::sqrt(r2));
+            fluid_sum += (pi_rho2 + pressure_term[j]) * c.kernel.grad_W_r2(d, r2);
         });
-        auto boundary = [&](std::uint32_t b) {
+        neighbors.gather_boundary(i, position[i], [&](std::uint32_t b) {
             const Vec3 d = xi - position[b];
             const Real r2 = norm2(d);
-            if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.grad_W(d, std::sqrt(r2));
-        };
-        grid.for_each_static(position[i], boundary);
-        grid.for_each_solid(position[i], boundary);
+            if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.grad_W_r2(d, r2);
+        });
         pressure_acc[i] = -(c.mass * fluid_sum + (c.rest_density * pi_rho2) * boundary_sum);
+    });
+}
+
+// p/ρ² from stored pressure and density (for a warm start, before the first density pass).
+inline void pressure_term_from_pressure(std::size_t fluid_count, View<const Real> density, View<const Real> pressure,
+                                        View<Real> pressure_term) {
+    parallel_for("pcisph_pressure_term", fluid_count, [=] MW_HD(std::size_t i) {
+        pressure_term[i] = pressure[i] / (density[i] * density[i]);
     });
 }
 

@@ -13,6 +13,7 @@ constexpr Real kPi = Real(3.14159265358979323846);
 // Cubic spline (Monaghan) with compact support h: W > 0 for r < h. Normalised in 3D.
 struct CubicSpline3D {
     Real h = 1;
+    Real inv_h = 1;
     Real sigma = 0;        // 8 / (π h³)
     Real grad_scale = 0;   // 48 / (π h⁴)
     Real visc_scale = 0;   // 45 / (π h⁶), Müller et al. 2003 viscosity Laplacian
@@ -20,30 +21,39 @@ struct CubicSpline3D {
     static CubicSpline3D with_support(Real support) {
         CubicSpline3D k;
         k.h = support;
+        k.inv_h = Real(1) / support;
         k.sigma = Real(8) / (kPi * support * support * support);
         k.grad_scale = Real(48) / (kPi * support * support * support * support);
         k.visc_scale = Real(45) / (kPi * support * support * support * support * support * support);
         return k;
     }
+    // Branch-free form of the two pieces: for q ≤ 1/2, 2(1-q)³ - 8(1/2-q)³ = 6(q³-q²) + 1.
     MW_INLINE Real W(Real r) const {
-        const Real q = r / h;
+        const Real q = r * inv_h;
         if (q >= Real(1)) return Real(0);
-        if (q <= Real(0.5)) return sigma * (Real(6) * (q * q * q - q * q) + Real(1));
-        const Real t = Real(1) - q;
-        return sigma * Real(2) * t * t * t;
+        const Real a = Real(1) - q;
+        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
+        return sigma * (Real(2) * a * a * a - Real(8) * b * b * b);
     }
     // ∇_i W(x_i - x_j) for r_vec = x_i - x_j, |r_vec| = r (passed in because callers have it).
+    // dW/dq / σ = -6(1-q)² + 24 max(1/2-q, 0)², equal to 6q(3q-2) for q ≤ 1/2.
     MW_INLINE Vec3 grad_W(Vec3 r_vec, Real r) const {
-        const Real q = r / h;
+        const Real q = r * inv_h;
         if (q >= Real(1) || r <= Real(1e-9) * h) return Vec3{0, 0, 0};
-        Real dwdq;
-        if (q <= Real(0.5))
-            dwdq = q * (Real(3) * q - Real(2));
-        else {
-            const Real t = Real(1) - q;
-            dwdq = -t * t;
-        }
+        const Real a = Real(1) - q;
+        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
+        const Real dwdq = Real(4) * b * b - a * a;  // (dW/dq) / (6σ)
         return (grad_scale * dwdq / r) * r_vec;
+    }
+    // The same from |r_vec|² alone, with one reciprocal square root and no division (hot loops).
+    MW_INLINE Vec3 grad_W_r2(Vec3 r_vec, Real r2) const {
+        if (r2 <= Real(1e-18) * h * h) return Vec3{0, 0, 0};
+        const Real inv_r = Real(1) / std::sqrt(r2);
+        const Real q = r2 * inv_r * inv_h;
+        if (q >= Real(1)) return Vec3{0, 0, 0};
+        const Real a = Real(1) - q;
+        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
+        return (grad_scale * (Real(4) * b * b - a * a) * inv_r) * r_vec;
     }
     // Laplacian of the viscosity kernel; never negative, so viscosity never injects energy.
     MW_INLINE Real laplacian_visc(Real r) const { return r < h ? visc_scale * (h - r) : Real(0); }

@@ -11,10 +11,12 @@
 
 #include "algorithms/array_ops.hpp"
 #include "algorithms/neighbor_grid.hpp"
+#include "algorithms/neighbor_list.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/pcisph.hpp"
 #include "algorithms/pcisph_delta.hpp"
 #include "algorithms/simulation.hpp"
+#include "algorithms/solid_bodies.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -29,71 +31,87 @@ class BackendSimulation final : public Simulation {
         // 1. Neighbour search: sort moving particles by cell, permute every field, cell ranges.
         timers_.start(kNeighbors);
         ranges_ = grid_.build(store_);
-        timers_.stop(kNeighbors);
+        if (solids_.active()) solids_.update_slot_map(store_);  // slot -> store index after the sort
         const std::size_t fluid_count = ranges_.fluid_end;
         const GridView grid = grid_.view();
+        if (use_lists_) {
+            // The skin covers how far particles move while PCISPH predicts (both ends of a pair).
+            const Real skin = Real(0.1) * fluid_.kernel.h + Real(2) * dt * static_cast<Real>(last_max_speed_);
+            lists_.build(grid, fluid_count, store_.position.cview(), fluid_.kernel.h + skin);
+        }
+        timers_.stop(kNeighbors);
 
         // 2. Boundary volumes of moving solids (static ones were computed once).
-        //    (Added with deformable solids.)
+        if (has_solid_volumes_) {
+            timers_.start(kSolidVolumes);
+            compute_boundary_volumes(grid, store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
+                                     ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+            timers_.stop(kSolidVolumes);
+        }
 
-        // 3. Non-pressure forces: gravity, viscosity (Eq. 4).
+        // 3. Non-pressure forces: gravity, viscosity (Eq. 4), wall friction (Eq. 8).
         if (has_viscosity_) {
             timers_.start(kViscosity);
             compute_viscosity_acceleration(grid, fluid_count, store_.position.cview(), store_.velocity.cview(),
-                                           store_.density.cview(), nonpressure_.view(), fluid_);
+                                           store_.density.cview(), boundary_volume_.cview(), nonpressure_.view(),
+                                           fluid_);
             timers_.stop(kViscosity);
         }
         const Vec3* nonpressure = has_viscosity_ ? nonpressure_.view().data() : nullptr;
 
         // 4. PCISPH: predict, density, pressure, pressure force, until the average density
         //    error is below η (at least min, at most max iterations).
-        timers_.start(kPcisph);
-        const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
-        if (solver.warm_start > 0) {
-            scale_prefix(store_.pressure.view(), fluid_count, solver.warm_start);
-            // Start from last step's pressure (persistent, permuted with the particles): in a
-            // settled fluid the iterations then only correct what changed.
-            predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
-                              nullptr, predicted_.view(), fluid_.gravity, dt);
-            pressure_acceleration(grid, fluid_count, predicted_.cview(), store_.position.cview(),
-                                  boundary_volume_.cview(), store_.density.cview(), store_.pressure.cview(),
-                                  pressure_acc_.view(), fluid_);
-        } else {
-            fill_prefix(store_.pressure.view(), fluid_count, Real(0));
-            fill_prefix(pressure_acc_.view(), fluid_count, Vec3{0, 0, 0});
-        }
-        DensityError error;
         int iterations = 0;
-        while (iterations < solver.max_iterations) {
-            predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
-                              pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt);
-            predict_density_and_pressure(grid, fluid_count, predicted_.cview(), store_.position.cview(),
-                                         boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
-                                         fluid_, delta);
-            error = density_error(fluid_count, store_.density.cview(), fluid_.rest_density);
-            pressure_acceleration(grid, fluid_count, predicted_.cview(), store_.position.cview(),
-                                  boundary_volume_.cview(), store_.density.cview(), store_.pressure.cview(),
-                                  pressure_acc_.view(), fluid_);
-            ++iterations;
-            const double average = fluid_count ? error.sum / double(fluid_count) : 0.0;
-            if (iterations >= solver.min_iterations && average <= solver.eta) break;
+        DensityError error;
+        if (has_fluid_) {
+            timers_.start(kPcisph);
+            const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
+            if (solver.warm_start > 0) {
+                scale_prefix(store_.pressure.view(), fluid_count, solver.warm_start);
+                // Start from last step's pressure (persistent, permuted with the particles): in a
+                // settled fluid the iterations then only correct what changed.
+                predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure, nullptr,
+                                  predicted_.view(), fluid_.gravity, dt);
+                pressure_term_from_pressure(fluid_count, store_.density.cview(), store_.pressure.cview(),
+                                            pressure_term_.view());
+                pressure_acceleration(grid, fluid_count, predicted_.cview(), store_.position.cview(),
+                                      boundary_volume_.cview(), pressure_term_.cview(), pressure_acc_.view(), fluid_);
+            } else {
+                fill_prefix(store_.pressure.view(), fluid_count, Real(0));
+                fill_prefix(pressure_acc_.view(), fluid_count, Vec3{0, 0, 0});
+            }
+            error = use_lists_ ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, iterations)
+                               : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, iterations);
+            timers_.stop(kPcisph);
         }
-        timers_.stop(kPcisph);
 
-        // 5.-6. Coupling forces and solids (LSM) go here with deformable solids.
+        // 5. Coupling forces on solids go here (they fill solids_.force()).
+        // 6. Solids: LSM of the IBPs (forces, gravity, domain walls), then GPs (Eq. 19) and SBPs.
+        SolidSummary solid_motion;
+        if (solids_.active()) {
+            timers_.start(kLsm);
+            solid_motion = solids_.step(store_, dt, params_.gravity, params_.domain_min, params_.domain_max);
+            timers_.stop(kLsm);
+        }
 
         // 7. Integrate fluid (symplectic Euler); guard against NaN/inf; statistics.
-        timers_.start(kIntegrate);
-        integrate_fluid(fluid_count, store_.position.view(), store_.velocity.view(), nonpressure,
-                        pressure_acc_.cview(), fluid_.gravity, dt);
-        const MotionSummary motion =
-            summarize_motion(fluid_count, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
-        timers_.stop(kIntegrate);
+        MotionSummary motion;
+        if (has_fluid_) {
+            timers_.start(kIntegrate);
+            integrate_fluid(fluid_count, store_.position.view(), store_.velocity.view(), nonpressure,
+                            pressure_acc_.cview(), fluid_.gravity, dt);
+            motion = summarize_motion(fluid_count, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
+            timers_.stop(kIntegrate);
+        }
 
         time_ += dt;
         ++step_;
         if (motion.first_bad != 0xffffffffu) report_non_finite(motion.first_bad);
+        if (solid_motion.first_bad != 0xffffffffu)
+            report_non_finite(solids_.store_index_of_slot(solid_motion.first_bad), "solid inner particle (IBP)");
         fill_report(dt, iterations, error, fluid_count, motion);
+        report_.solid_kinetic_energy = solid_motion.kinetic_energy;
+        report_.solid_max_speed = std::sqrt(double(solid_motion.max_speed2));
     }
 
     const StepReport& last_report() const override { return report_; }
@@ -105,16 +123,41 @@ class BackendSimulation final : public Simulation {
     void download(HostParticles& out) const override;
     ParticleCounts counts() const override { return counts_; }
     std::size_t device_bytes() const override {
-        return store_.bytes() + grid_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
-               pressure_acc_.bytes() + predicted_.bytes();
+        return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
+               pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes();
     }
     double time() const override { return time_; }
     std::string backend_name() const override { return kBackendName; }
     std::string device_name() const override { return device_description(); }
 
    private:
-    enum Stage { kNeighbors, kViscosity, kPcisph, kIntegrate, kStageCount };
-    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "viscosity", "pcisph", "integrate"};
+    // The PCISPH loop over a neighbourhood (the grid, or this step's lists): predict, density and
+    // pressure, error, pressure force; until the average error is below η (min/max iterations).
+    template <class Neighbors>
+    DensityError pcisph_iterations(const Neighbors& neighbors, std::size_t fluid_count, const Vec3* nonpressure,
+                                   Real delta, Real dt, int& iterations) {
+        const SolverParams& solver = params_.solver;
+        DensityError error;
+        iterations = 0;
+        while (iterations < solver.max_iterations) {
+            predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
+                              pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt);
+            predict_density_and_pressure(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
+                                         boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
+                                         pressure_term_.view(), fluid_, delta);
+            error = density_error(fluid_count, store_.density.cview(), fluid_.rest_density);
+            pressure_acceleration(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
+                                  boundary_volume_.cview(), pressure_term_.cview(), pressure_acc_.view(), fluid_);
+            ++iterations;
+            const double average = fluid_count ? error.sum / double(fluid_count) : 0.0;
+            if (iterations >= solver.min_iterations && average <= solver.eta) break;
+        }
+        return error;
+    }
+
+    enum Stage { kNeighbors, kSolidVolumes, kViscosity, kPcisph, kLsm, kIntegrate, kStageCount };
+    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "solid_volumes", "viscosity",
+                                                             "pcisph",    "lsm",           "integrate"};
 
     Real choose_time_step() const {
         const SolverParams& solver = params_.solver;
@@ -145,7 +188,7 @@ class BackendSimulation final : public Simulation {
         last_max_speed_ = report_.max_speed;
     }
 
-    void report_non_finite(std::uint32_t index) const {
+    void report_non_finite(std::uint32_t index, const char* what = "fluid particle") const {
         std::uint32_t scene_index = 0;
         Vec3 x{0, 0, 0}, v{0, 0, 0};
         store_.id.download_range(&scene_index, index, 1);
@@ -153,9 +196,9 @@ class BackendSimulation final : public Simulation {
         store_.velocity.download_range(&v, index, 1);
         char text[320];
         std::snprintf(text, sizeof text,
-                      "step %ld (t = %.6g s): fluid particle %u became non-finite (position %g %g %g, velocity %g "
+                      "step %ld (t = %.6g s): %s %u became non-finite (position %g %g %g, velocity %g "
                       "%g %g); try a smaller dt, or dt_mode \"cfl\"",
-                      step_, time_, scene_index, double(x.x), double(x.y), double(x.z), double(v.x), double(v.y),
+                      step_, time_, what, scene_index, double(x.x), double(x.y), double(x.z), double(v.x), double(v.y),
                       double(v.z));
         throw SimulationError(text);
     }
@@ -165,14 +208,20 @@ class BackendSimulation final : public Simulation {
     double delta_times_dt2_ = 0;  // δ·Δt², from the prototype lattice
     ParticleStore store_;
     NeighborGrid grid_;
+    NeighborList lists_;
+    bool use_lists_ = false;
     GroupRanges ranges_;
-    DeviceArray<Real> boundary_volume_;   // V_b, indexed like the store (fluid entries unused)
-    DeviceArray<Vec3> nonpressure_;       // gravity + viscosity; only when μ > 0
+    DeviceArray<Real> boundary_volume_;  // V_b, indexed like the store (fluid entries unused)
+    DeviceArray<Vec3> nonpressure_;      // gravity + viscosity; only when μ > 0
     DeviceArray<Vec3> pressure_acc_;
+    DeviceArray<Real> pressure_term_;  // p/ρ² of this iteration
     DeviceArray<Vec3> predicted_;
     StageTimers timers_{kStageCount};
     std::vector<int> active_stages_;
     bool has_viscosity_ = false;
+    bool has_fluid_ = false;
+    bool has_solid_volumes_ = false;  // moving solids and fluid: boundary volumes every step
+    SolidBodies solids_;
     ParticleCounts counts_;
     long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
     double time_ = 0;
@@ -210,7 +259,8 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
         ++counts_.by_type[type[k]];
         if (type[k] == kGeometry) ++inactive_by_design_;
         if (!is_finite(position[k]) || !is_finite(velocity[k]))
-            throw InputError("simulation setup: particle " + std::to_string(i) + " has a non-finite position or velocity");
+            throw InputError("simulation setup: particle " + std::to_string(i) +
+                             " has a non-finite position or velocity");
         if (type[k] == kStaticBoundary) {  // the grid must hold every static particle
             lo = Vec3{std::min(lo.x, position[k].x), std::min(lo.y, position[k].y), std::min(lo.z, position[k].z)};
             hi = Vec3{std::max(hi.x, position[k].x), std::max(hi.y, position[k].y), std::max(hi.z, position[k].z)};
@@ -225,17 +275,20 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     store_.object.upload(object);
     store_.density.fill(fp.rest_density);
     store_.pressure.fill(Real(0));
+    solids_.init(setup, order, store_);  // the solid_slot field, regions, interpolation links
 
     // The grid covers the domain, its walls and one support radius more; fluid that leaves it is
     // counted as lost.
     const Real h = fp.support_radius;
-    grid_.configure(Vec3{lo.x - h, lo.y - h, lo.z - h}, Vec3{hi.x + h, hi.y + h, hi.z + h}, h, params_.ordering);
+    grid_.configure(Vec3{lo.x - h, lo.y - h, lo.z - h}, Vec3{hi.x + h, hi.y + h, hi.z + h}, h, params_.ordering,
+                    params_.cells_per_support);
     grid_.build_static(store_);
 
     fluid_.kernel = SphKernel::with_support(h);
     fluid_.support2 = h * h;
     fluid_.rest_density = fp.rest_density;
     fluid_.viscosity = fp.viscosity;
+    fluid_.wall_viscosity = fp.wall_viscosity;
     fluid_.gravity = params_.gravity;
     // Mass such that the prototype lattice at spacing r0 has exactly the rest density.
     const PrototypeSums sums = prototype_sums(fluid_.kernel, fp.spacing, 3);
@@ -247,15 +300,23 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
         compute_boundary_volumes(grid_.view(), store_.position.cview(), boundary_volume_.view(), moving,
                                  store_.static_count(), false, fluid_.kernel);
 
-    has_viscosity_ = fp.viscosity > 0;
+    use_lists_ = params_.neighbor_lists == SimulationParams::Lists::kAuto
+                     ? kPrefersNeighborLists
+                     : params_.neighbor_lists == SimulationParams::Lists::kOn;
+    has_fluid_ = counts_.by_type[kFluid] > 0;  // a solids-only scene runs no fluid stage
+    has_viscosity_ = has_fluid_ && (fp.viscosity > 0 || (fp.wall_viscosity > 0 && store_.static_count() > 0));
     active_stages_.push_back(kNeighbors);
+    has_solid_volumes_ = solids_.active() && counts_.by_type[kFluid] > 0;
+    if (has_solid_volumes_) active_stages_.push_back(kSolidVolumes);
     if (has_viscosity_) {
         active_stages_.push_back(kViscosity);
         nonpressure_.resize(moving);
     }
-    active_stages_.push_back(kPcisph);
-    active_stages_.push_back(kIntegrate);
+    if (has_fluid_) active_stages_.push_back(kPcisph);
+    if (solids_.active()) active_stages_.push_back(kLsm);
+    if (has_fluid_) active_stages_.push_back(kIntegrate);
     pressure_acc_.resize(moving);
+    pressure_term_.resize(moving);
     predicted_.resize(moving);
 
     // The first CFL step uses the initial speeds.

@@ -76,7 +76,10 @@ int command_run(int argc, char** argv) {
     make_directories(out_dir);
     const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
     std::unique_ptr<FrameWriter> frames;
-    if (scene.writes_vtu()) frames = std::make_unique<FrameWriter>(out_dir);
+    if (scene.writes_vtu()) {
+        frames = std::make_unique<FrameWriter>(out_dir);
+        frames->set_objects(setup.solids);
+    }
     StatsTable stats(sim->stage_names());
 
     RunSummary summary;

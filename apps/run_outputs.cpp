@@ -31,7 +31,8 @@ FrameWriter::FrameWriter(const std::string& out_dir) : frames_dir_(out_dir + "/f
     std::error_code error;
     for (const auto& entry : std::filesystem::directory_iterator(frames_dir_, error)) {
         const std::string name = entry.path().filename().string();
-        if ((name.rfind("particles_", 0) == 0 && entry.path().extension() == ".vtu") || name == "particles.pvd")
+        if ((name.rfind("particles_", 0) == 0 && entry.path().extension() == ".vtu") || name == "particles.pvd" ||
+            (name.rfind("object_", 0) == 0 && entry.path().extension() == ".obj"))
             std::filesystem::remove(entry.path(), error);
     }
 }
@@ -47,6 +48,7 @@ std::string FrameWriter::write(int index, const HostParticles& p, double time) {
     arrays.push_back(VtuArray::uint8("type", p.type));
     arrays.push_back(VtuArray::int32("object", p.object));
     write_vtu(path, p.position, arrays);
+    write_objects(index, p);
     ++written_;
     collection_.emplace_back(time, name);
     write_file_atomically(frames_dir_ + "/particles.pvd", [&](std::ostream& out) {
@@ -59,6 +61,29 @@ std::string FrameWriter::write(int index, const HostParticles& p, double time) {
         out << "  </Collection>\n</VTKFile>\n";
     });
     return path;
+}
+
+void FrameWriter::write_objects(int index, const HostParticles& p) const {
+    for (const SolidSetup& o : objects_) {
+        char name[64];
+        std::snprintf(name, sizeof name, "_%05d.obj", index);
+        const std::string path = frames_dir_ + "/object_" + o.name + name;
+        write_file_atomically(path, [&](std::ostream& out) {
+            out << "# meltwater object " << o.name << ", frame " << index << "\n";
+            char line[128];
+            const bool moving = o.kind != SolidKind::kStatic;
+            const std::size_t n = moving ? o.gp.size() : o.rest_vertices.size();
+            for (std::size_t g = 0; g < n; ++g) {
+                const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
+                std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", double(x.x), double(x.y), double(x.z));
+                out << line;
+            }
+            for (const auto& t : o.triangles) {
+                std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+                out << line;
+            }
+        });
+    }
 }
 
 StatsTable::StatsTable(std::vector<std::string> stage_names) : stages_(std::move(stage_names)) {}

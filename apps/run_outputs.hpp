@@ -1,5 +1,6 @@
 // What `meltwater run` writes into its output directory, each file atomically:
 //   frames/particles_NNNNN.vtu   the particles (velocity, density, pressure, type, object)
+//   frames/object_NAME_NNNNN.obj the deformed mesh (GP positions) of each solid object, same NNNNN
 //   stats.csv                    one row per step
 //   summary.json                 the run in one object, the resolved scene included
 #pragma once
@@ -12,10 +13,12 @@
 
 namespace mw {
 
-// Writes frames/particles_NNNNN.vtu.
+// Writes frames/particles_NNNNN.vtu (and the objects' meshes, once set_objects() was called).
 class FrameWriter {
    public:
-    explicit FrameWriter(const std::string& out_dir);  // creates frames/, removes stale particles_*.vtu
+    explicit FrameWriter(const std::string& out_dir);  // creates frames/, removes stale particles_*.vtu, object_*.obj
+    // The solid objects whose meshes go with every frame (static ones: their rest mesh).
+    void set_objects(const std::vector<SolidSetup>& solids) { objects_ = solids; }
     // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView
     // collection listing every frame with its time. Returns the frame's path.
     std::string write(int index, const HostParticles& particles, double time);
@@ -23,7 +26,9 @@ class FrameWriter {
     const std::string& directory() const { return frames_dir_; }
 
    private:
+    void write_objects(int index, const HostParticles& particles) const;
     std::string frames_dir_;
+    std::vector<SolidSetup> objects_;
     int written_ = 0;
     std::vector<std::pair<double, std::string>> collection_;
 };

@@ -280,6 +280,7 @@ void read_fluid(Section s, Scene& scene) {
     f.spacing = Real(r0);
     f.support_radius = Real(s.number("support_radius", 2 * r0, Range{r0, 4 * r0, true, false}));
     f.viscosity = Real(s.number("viscosity", 0.0, Range::non_negative()));
+    f.wall_viscosity = Real(s.number("wall_viscosity", 0.0, Range::non_negative()));
     s.finish();
 }
 
@@ -291,6 +292,7 @@ void read_solver(Section s, Scene& scene) {
     p.eta = Real(s.number("eta", 0.01, Range{0, 1, true, true}));
     p.min_iterations = s.integer("min_iterations", 3, 1, 1000);
     p.max_iterations = s.integer("max_iterations", 100, 1, 10000);
+    p.warm_start = Real(s.number("warm_start", 0.0, Range{0, 1, false, true}));
     if (p.max_iterations < p.min_iterations)
         s.fail(s.key_path("max_iterations"), "must be >= min_iterations (" + std::to_string(p.min_iterations) +
                                                  "), got " + std::to_string(p.max_iterations));
@@ -307,6 +309,11 @@ void read_boundary(Section s, Scene& scene) {
 void read_neighbors(Section s, Scene& scene) {
     scene.params.ordering =
         s.choice("ordering", "zorder", {"zorder", "linear"}) == "linear" ? CellOrdering::kLinear : CellOrdering::kZOrder;
+    scene.params.cells_per_support = s.integer("cells_per_support", 1, 1, 2);
+    const std::string lists = s.choice("lists", "auto", {"auto", "on", "off"});
+    scene.params.neighbor_lists = lists == "on"    ? SimulationParams::Lists::kOn
+                                  : lists == "off" ? SimulationParams::Lists::kOff
+                                                   : SimulationParams::Lists::kAuto;
     s.finish();
 }
 
@@ -320,7 +327,6 @@ void read_fluid_blocks(Section& root, Scene& scene) {
             s.fail(s.path(), "the block must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
         scene.fluid_blocks.push_back(b);
     });
-    if (scene.fluid_blocks.empty()) root.fail("fluid_blocks", "at least one fluid block is needed");
 }
 
 void read_static_boxes(Section& root, Scene& scene) {
@@ -332,6 +338,75 @@ void read_static_boxes(Section& root, Scene& scene) {
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the box must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
         scene.static_boxes.push_back(b);
+    });
+}
+
+void read_object_mesh(Section s, SceneObject& o) {
+    o.mesh_file = s.string("file", "");
+    o.mesh_procedural = s.string("procedural", "");
+    if (o.mesh_file.empty() == o.mesh_procedural.empty())
+        s.fail(s.path(), "give exactly one of \"file\" (an OBJ file) or \"procedural\" (e.g. \"sphere:radius=0.1\")");
+    s.finish();
+}
+
+void read_object_transform(Section s, SceneObject& o) {
+    const Vec3 scale = s.vec3("scale", std::array<double, 3>{1, 1, 1});
+    if (scale.x == 0 || scale.y == 0 || scale.z == 0) s.fail(s.key_path("scale"), "must be non-zero on every axis");
+    const Vec3 rotation = s.vec3("rotation_deg", std::array<double, 3>{0, 0, 0});
+    const Vec3 translation = s.vec3("translation", std::array<double, 3>{0, 0, 0});
+    o.scale = {scale.x, scale.y, scale.z};
+    o.rotation_deg = {rotation.x, rotation.y, rotation.z};
+    o.translation = {translation.x, translation.y, translation.z};
+    s.finish();
+}
+
+void read_object_lsm(Section s, SceneObject& o) {
+    o.region_half_width = s.integer("w", 2, 1, 8);
+    o.stiffness = Real(s.number("alpha", 1.0, Range{0, 1, true, false}));
+    o.damping = Real(s.number("damping", 0.0, Range::non_negative()));
+    o.wall_friction = Real(s.number("wall_friction", 0.2, Range{0, 1, false, false}));
+    s.finish();
+}
+
+void read_object_pinned(Section s, SceneObject& o) {
+    const bool has_box = s.find("box") != nullptr, has_half = s.find("half_space") != nullptr;
+    if (has_box && has_half) s.fail(s.path(), "give either \"box\" or \"half_space\", not both");
+    if (has_box) {
+        Section b = s.object("box");
+        o.pin = SceneObject::Pin::kBox;
+        o.pin_min = b.vec3("min", std::nullopt);
+        o.pin_max = checked_box(b, o.pin_min, b.vec3("max", std::nullopt));
+        b.finish();
+    }
+    if (has_half) {
+        Section h = s.object("half_space");
+        o.pin = SceneObject::Pin::kHalfSpace;
+        o.pin_point = h.vec3("point", std::nullopt);
+        o.pin_normal = h.vec3("normal", std::nullopt);
+        if (!(norm(o.pin_normal) > 0)) h.fail(h.key_path("normal"), "must be non-zero");
+        h.finish();
+    }
+    s.finish();
+}
+
+void read_objects(Section& root, Scene& scene) {
+    root.array_of_objects("objects", [&](Section& s, int index) {
+        SceneObject o;
+        o.name = s.string("name", "object" + std::to_string(index));
+        if (o.name.empty() || o.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+                                  std::string::npos)
+            s.fail(s.key_path("name"), "use letters, digits, '_' and '-' only (it names output files), got \"" + o.name + "\"");
+        for (const auto& other : scene.objects)
+            if (other.name == o.name) s.fail(s.key_path("name"), "two objects are named \"" + o.name + "\"");
+        read_object_mesh(s.object("mesh"), o);
+        read_object_transform(s.object("transform"), o);
+        const std::string kind = s.choice("kind", "elastic", {"elastic", "rigid", "static"});
+        o.kind = kind == "rigid" ? SolidKind::kRigid : kind == "static" ? SolidKind::kStatic : SolidKind::kElastic;
+        o.density = Real(s.number("density", 1000.0, Range::positive()));
+        o.velocity = s.vec3("velocity", std::array<double, 3>{0, 0, 0});
+        read_object_lsm(s.object("lsm"), o);
+        read_object_pinned(s.object("pinned"), o);
+        scene.objects.push_back(o);
     });
 }
 
@@ -473,9 +548,11 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_neighbors(root.object("neighbors"), scene);
     read_fluid_blocks(root, scene);
     read_static_boxes(root, scene);
+    read_objects(root, scene);
+    if (scene.fluid_blocks.empty() && scene.objects.empty())
+        root.fail("fluid_blocks", "at least one fluid block (or one object) is needed");
     read_run(root.object("run"), scene);
     read_output(root.object("output"), scene);
-    // (A later issue adds `objects`, deformable solids from meshes: one more read_objects here.)
     root.finish();
     scene.resolved = out;
     return scene;
@@ -507,7 +584,9 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
     if (path.empty()) return parse_scene_text(default_scene_text(), "built-in default scene", overrides);
-    return parse_scene_text(read_file(path), path, overrides);
+    Scene scene = parse_scene_text(read_file(path), path, overrides);
+    scene.base_dir = std::filesystem::path(path).parent_path().string();
+    return scene;
 }
 
 }  // namespace mw

@@ -3,6 +3,7 @@
 // (for example `solver.eta` or `fluid_blocks[1].min`). `--set path.to.key=value` overrides are
 // applied to the raw JSON before validation, so they go through the same checks.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,24 @@ struct StaticBox {
     int layers = 1;
 };
 
+// A solid object from a mesh (docs/scenes.md, "objects"; docs/lsm.md).
+struct SceneObject {
+    std::string name;
+    std::string mesh_file;        // an OBJ file (relative paths: from the scene file's folder) ...
+    std::string mesh_procedural;  // ... or a procedural spec such as "box:x=0.5,y=0.1,z=0.1"
+    std::array<double, 3> scale{1, 1, 1}, rotation_deg{0, 0, 0}, translation{0, 0, 0};
+    SolidKind kind = SolidKind::kElastic;
+    Real density = 1000;
+    Vec3 velocity{0, 0, 0};
+    int region_half_width = 2;
+    Real stiffness = 1;
+    Real damping = 0;
+    Real wall_friction = 0.2;
+    enum class Pin { kNone, kBox, kHalfSpace } pin = Pin::kNone;
+    Vec3 pin_min{}, pin_max{};          // box
+    Vec3 pin_point{}, pin_normal{};     // half-space: IBPs with (x - point)·normal < 0 are pinned
+};
+
 struct Scene {
     std::string name;
     std::string source;                  // the file it came from, or "built-in default scene"
@@ -33,6 +52,8 @@ struct Scene {
     int boundary_layers = 1;
     std::vector<FluidBlock> fluid_blocks;
     std::vector<StaticBox> static_boxes;
+    std::vector<SceneObject> objects;
+    std::string base_dir;  // folder of the scene file ("" for text scenes): mesh paths are relative to it
     double end_time = 1.0;  // run.end_time, s
     double fps = 30;        // output.fps: frames per simulated second
     std::vector<std::string> formats{"vtu"};

@@ -5,6 +5,11 @@
 
 #include "backend/errors.hpp"
 #include "sampling/box_particles.hpp"
+#include "sampling/obj_loader.hpp"
+#include "sampling/procedural_meshes.hpp"
+#include "sampling/solid_sample.hpp"
+
+#include <filesystem>
 
 namespace mw {
 
@@ -56,14 +61,113 @@ SimulationSetup build_setup(const Scene& scene) {
     }
     const Real rb = scene.boundary_spacing();
     if (scene.walls)
-        append(setup, sample_container_walls(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers),
+        // First layer kWallGap r0 outside the faces: fluid blocks touching a wall start at rest density.
+        append(setup,
+               sample_container_walls(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers,
+                                      kWallGap * r0),
                Vec3{0, 0, 0}, kStaticBoundary, -1);
     for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
         const StaticBox& b = scene.static_boxes[i];
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
                static_cast<std::int32_t>(i));
     }
+    for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+        const SceneObject& o = scene.objects[k];
+        SolidSetup solid;
+        solid.name = o.name;
+        solid.kind = o.kind;
+        solid.density = o.density;
+        solid.region_half_width = o.region_half_width;
+        solid.stiffness = o.stiffness;
+        solid.damping = o.damping;
+        solid.wall_friction = o.wall_friction;
+        std::function<bool(const Vec3&)> pinned;
+        if (o.pin == SceneObject::Pin::kBox) {
+            const Vec3 lo = o.pin_min, hi = o.pin_max;
+            pinned = [lo, hi](const Vec3& x) {
+                return x.x >= lo.x && x.y >= lo.y && x.z >= lo.z && x.x <= hi.x && x.y <= hi.y && x.z <= hi.z;
+            };
+        } else if (o.pin == SceneObject::Pin::kHalfSpace) {
+            const Vec3 p = o.pin_point, n = o.pin_normal;
+            pinned = [p, n](const Vec3& x) { return dot(x - p, n) < 0; };
+        }
+        const std::int32_t id = static_cast<std::int32_t>(scene.static_boxes.size() + k);
+        try {
+            add_solid_object(setup, object_mesh(scene, o), solid, o.velocity, id, scene.params.fluid.spacing,
+                             scene.params.fluid.support_radius, pinned);
+        } catch (const InputError& e) {
+            throw InputError(scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + "): " + e.what());
+        }
+        if (static_cast<long>(setup.position.size()) > kMaxSceneParticles)
+            throw InputError(scene.source + ": the objects create more than " + std::to_string(kMaxSceneParticles) +
+                             " particles; increase fluid.spacing");
+    }
     return setup;
+}
+
+TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {
+    TriangleMesh mesh;
+    if (!o.mesh_procedural.empty()) {
+        mesh = make_procedural_from_spec(o.mesh_procedural);
+    } else {
+        std::filesystem::path path(o.mesh_file);
+        if (path.is_relative() && !scene.base_dir.empty()) path = std::filesystem::path(scene.base_dir) / path;
+        mesh = load_obj(path.string());
+    }
+    MeshTransform t;
+    t.scale = Vec3d(o.scale[0], o.scale[1], o.scale[2]);
+    t.rotation_deg = Vec3d(o.rotation_deg[0], o.rotation_deg[1], o.rotation_deg[2]);
+    t.translation = Vec3d(o.translation[0], o.translation[1], o.translation[2]);
+    apply_transform(mesh, t);
+    return mesh;
+}
+
+void add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
+                      std::int32_t object_id, double r0, double h, const std::function<bool(const Vec3&)>& pinned) {
+    SampleOptions options;
+    options.measure_coverage = false;
+    const SolidSample sample = sample_solid(mesh, r0, h, options);
+    if (sample.ibp.count() == 0)
+        throw InputError("the mesh holds no inner particle at spacing " + std::to_string(r0) +
+                         " (make it larger or decrease fluid.spacing)");
+    auto to_vec3 = [](const Vec3d& v) { return Vec3{Real(v.x()), Real(v.y()), Real(v.z())}; };
+    auto push = [&](const Vec3& x, std::uint8_t type) {
+        setup.position.push_back(x);
+        setup.velocity.push_back(solid.kind == SolidKind::kStatic ? Vec3{0, 0, 0} : velocity);
+        setup.type.push_back(type);
+        setup.object.push_back(object_id);
+        return static_cast<std::uint32_t>(setup.position.size() - 1);
+    };
+    solid.spacing = Real(r0);
+    // The sampler orients the mesh outward (flipping it when its volume is negative): do the same
+    // to the triangles kept for output.
+    for (const auto& t : mesh.triangles)
+        solid.triangles.push_back(sample.stats.flipped ? std::array<int, 3>{t[0], t[2], t[1]} : t);
+    if (solid.kind == SolidKind::kStatic) {
+        for (const auto& p : sample.ibp.positions) push(to_vec3(p), kStaticBoundary);
+        for (const auto& p : sample.sbp.positions) push(to_vec3(p), kStaticBoundary);
+        for (const auto& v : mesh.vertices) solid.rest_vertices.push_back(to_vec3(v));
+        setup.solids.push_back(std::move(solid));
+        return;
+    }
+    for (std::size_t k = 0; k < sample.ibp.count(); ++k) {
+        const Vec3 x = to_vec3(sample.ibp.positions[k]);
+        solid.ibp.push_back(push(x, kInnerBoundary));
+        solid.lattice.push_back(sample.ibp.lattice[k]);
+        solid.pinned.push_back(pinned && pinned(x) ? 1 : 0);
+    }
+    for (std::size_t g = 0; g < sample.gp.count(); ++g) solid.gp.push_back(push(to_vec3(sample.gp.positions[g]), kGeometry));
+    solid.gp_offsets = sample.gp.offsets;
+    solid.gp_links = sample.gp.ibp;
+    for (double w : sample.gp.weight) solid.gp_weights.push_back(Real(w));
+    for (std::size_t k = 0; k < sample.sbp.count(); ++k) {
+        solid.sbp.push_back(push(to_vec3(sample.sbp.positions[k]), kSurfaceBoundary));
+        // Barycentric weights refer to the corners of the sampler's (oriented) triangle.
+        solid.sbp_corners.push_back(solid.triangles[std::size_t(sample.sbp.triangles[k])]);
+        solid.sbp_barycentric.push_back(to_vec3(sample.sbp.barycentric[k]));
+        solid.sbp_normal.push_back(to_vec3(sample.sbp.normals[k]));
+    }
+    setup.solids.push_back(std::move(solid));
 }
 
 ParticleCounts count_particles(const SimulationSetup& setup) {

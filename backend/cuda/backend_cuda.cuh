@@ -27,6 +27,9 @@
 
 MW_BACKEND_BEGIN
 
+// Default for SimulationParams::neighbor_lists = kAuto: gathering from the sorted grid keeps memory per particle low; lists are to be measured on a GPU.
+constexpr bool kPrefersNeighborLists = false;
+
 constexpr const char* kBackendName = "cuda";
 
 inline MemoryLedger& memory_ledger() {
@@ -122,6 +125,11 @@ class DeviceArray {
     void download_range(T* host, std::size_t first, std::size_t n) const {
         if (n)
             check_cuda(cudaMemcpy(host, ptr_ + first, n * sizeof(T), cudaMemcpyDeviceToHost), "download_range");
+    }
+    // Copies n host values to elements [first, first + n) (a handful of values, not a stream).
+    void upload_range(const T* host, std::size_t first, std::size_t n) {
+        if (n)
+            check_cuda(cudaMemcpy(ptr_ + first, host, n * sizeof(T), cudaMemcpyHostToDevice), "upload_range");
     }
     void fill(const T& value);
     void copy_from(const DeviceArray& other) {

@@ -71,7 +71,7 @@ struct Cloud {
     std::size_t kdtree_get_point_count() const { return points->size(); }
     float kdtree_get_pt(std::size_t i, std::size_t d) const {
         const Vec3& p = (*points)[i];
-        return d == 0 ? p.x : d == 1 ? p.y : p.z;
+        return float(d == 0 ? p.x : d == 1 ? p.y : p.z);
     }
     template <class B>
     bool kdtree_get_bbox(B&) const { return false; }
@@ -86,8 +86,8 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> nanoflann_pairs(const std::vec
     std::vector<std::pair<unsigned, float>> matches;
     nanoflann::SearchParams params;
     for (std::size_t i = 0; i < points.size(); ++i) {
-        const float q[3] = {points[i].x, points[i].y, points[i].z};
-        tree.radiusSearch(q, h * h, matches, params);
+        const float q[3] = {float(points[i].x), float(points[i].y), float(points[i].z)};
+        tree.radiusSearch(q, float(h * h), matches, params);
         for (const auto& m : matches)
             if (m.first != i) pairs.insert({std::uint32_t(i), std::uint32_t(m.first)});
     }
@@ -95,7 +95,7 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> nanoflann_pairs(const std::vec
 }
 
 std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<Vec3>& points, Vec3 lo, Vec3 hi, Real h,
-                                                            CellOrdering ordering) {
+                                                            CellOrdering ordering, int cells_per_h) {
     ParticleStore store;
     const std::size_t n = points.size();
     store.resize(n, n);
@@ -105,7 +105,7 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<V
     store.position.upload(points);
     store.type.fill(kFluid);
     NeighborGrid grid;
-    grid.configure(lo, hi, h, ordering);
+    grid.configure(lo, hi, h, ordering, cells_per_h);
     const GroupRanges ranges = grid.build(store);
     REQUIRE(ranges.fluid_end == n);
     const GridView view = grid.view();
@@ -122,30 +122,33 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<V
 
 TEST_CASE("grid neighbours equal nanoflann's radius search") {
     std::mt19937 rng(11);
-    std::uniform_real_distribution<float> unit(0.f, 1.f);
-    const Vec3 lo{0, 0, 0}, hi{1.0f, 0.6f, 0.4f};
-    const Real h = 0.05f;
+    std::uniform_real_distribution<Real> unit(0, 1);
+    const Vec3 lo{0, 0, 0}, hi{Real(1.0), Real(0.6), Real(0.4)};
+    const Real h = Real(0.05), spread = Real(0.03), zero = 0, half = Real(0.5);
     std::vector<Vec3> points;
     for (int i = 0; i < 6000; ++i) points.push_back({unit(rng) * hi.x, unit(rng) * hi.y, unit(rng) * hi.z});
     // Clusters, leaving many cells empty, and particles on the domain's faces and corners.
     for (int c = 0; c < 4; ++c) {
         const Vec3 centre{unit(rng) * hi.x, unit(rng) * hi.y, unit(rng) * hi.z};
         for (int i = 0; i < 800; ++i)
-            points.push_back({std::clamp(centre.x + 0.03f * (unit(rng) - 0.5f), 0.f, hi.x),
-                              std::clamp(centre.y + 0.03f * (unit(rng) - 0.5f), 0.f, hi.y),
-                              std::clamp(centre.z + 0.03f * (unit(rng) - 0.5f), 0.f, hi.z)});
+            points.push_back({std::clamp(centre.x + spread * (unit(rng) - half), zero, hi.x),
+                              std::clamp(centre.y + spread * (unit(rng) - half), zero, hi.y),
+                              std::clamp(centre.z + spread * (unit(rng) - half), zero, hi.z)});
     }
     for (int i = 0; i < 200; ++i) {
-        points.push_back({0.f, unit(rng) * hi.y, unit(rng) * hi.z});
-        points.push_back({unit(rng) * hi.x, 0.f, hi.z * 0.999f});
+        points.push_back({zero, unit(rng) * hi.y, unit(rng) * hi.z});
+        points.push_back({unit(rng) * hi.x, zero, hi.z * Real(0.999)});
     }
     points.push_back(lo);
     const auto expected = nanoflann_pairs(points, h);
     REQUIRE(expected.size() > 10000);
     // The grid spans the domain plus one support radius, as the simulation's does.
     const Vec3 grid_lo{-h, -h, -h}, grid_hi{hi.x + h, hi.y + h, hi.z + h};
-    CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kLinear) == expected);
-    CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kZOrder) == expected);
+    for (int cells_per_h : {1, 2}) {
+        CAPTURE(cells_per_h);
+        CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kLinear, cells_per_h) == expected);
+        CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kZOrder, cells_per_h) == expected);
+    }
 }
 
 TEST_CASE("particles outside the grid are set aside, not lost silently") {

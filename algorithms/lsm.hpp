@@ -1,0 +1,201 @@
+// Lattice shape matching, per-step part (device): region sums and rotations, then goals and the
+// velocity/position update of every IBP. Data layout: lsm_regions.hpp; the class that owns the
+// arrays and calls these stages: solid_bodies.hpp. The algebra (METHOD.md, "Lattice shape
+// matching"), written in displacements u = x - x0 so that nothing cancels catastrophically in
+// float and a body at rest stays bitwise at rest:
+//   c_r = c0_r + ū_r,            ū_r = u_a + Σ m̃ (u - u_a) / M_r   (u_a: one member's, the anchor)
+//   A_r = A0_r + Σ m̃ (u - u_a) qᵀ, q = x0 - c0_r, A0_r = Σ m̃ q qᵀ (precomputed, exactly symmetric;
+//                                  Σ m̃ q = 0, so subtracting u_a changes nothing but rounding)
+//   R_r = polar(A_r), warm-started from last step's R_r
+//   g_i - x_i = mean_r [(R_r - I) q_ir + ū_r] - u_i
+// Every kernel is a gather (each thread writes only its own region or particle): deterministic.
+#pragma once
+#include <cmath>
+
+#include "algorithms/lsm_regions.hpp"
+#include "algorithms/polar_decomposition.hpp"
+#include "backend/backend.hpp"
+
+MW_BACKEND_BEGIN
+
+// Raw device pointers of the LSM state, captured by value in kernels.
+struct LsmData {
+    // The particle store (positions and velocities of all particles) and the slot map.
+    Vec3* position = nullptr;
+    Vec3* velocity = nullptr;
+    const std::uint32_t* store_of_slot = nullptr;
+    // IBPs (slots 0 .. ibp_count)
+    std::uint32_t ibp_count = 0;
+    const Vec3* rest = nullptr;
+    const Real* mass = nullptr;
+    const Real* split_mass = nullptr;
+    const std::int32_t* object = nullptr;
+    const std::uint8_t* pinned = nullptr;
+    const std::uint32_t* regions_begin = nullptr;
+    const std::uint32_t* regions_end = nullptr;
+    const Vec3* force = nullptr;  // external force per IBP (the coupling fills it)
+    Mat3* mean_rotation = nullptr;  // average rotation of the IBP's regions (for Eq. 19)
+    // Regions
+    std::uint32_t region_count = 0;
+    const std::uint32_t* region_offsets = nullptr;
+    const std::uint32_t* member_index = nullptr;
+    const Real* region_mass = nullptr;
+    const Vec3* region_c0 = nullptr;
+    const SymMat3* region_A0 = nullptr;
+    const SymMat3* region_inertia_inv = nullptr;
+    const std::int32_t* region_object = nullptr;
+    Quat* rotation = nullptr;
+    Vec3* mean_displacement = nullptr;
+    Vec3* region_velocity = nullptr;  // only written for objects with damping
+    Vec3* region_omega = nullptr;
+    const LsmObjectParams* objects = nullptr;
+};
+
+struct LsmStepParams {
+    Real dt = 0;
+    Vec3 gravity{0, 0, 0};
+    Vec3 domain_min{0, 0, 0}, domain_max{0, 0, 0};
+};
+
+// Region sums, rotation (warm-started polar decomposition) and, for damped objects, the region's
+// rigid velocity (linear velocity V and angular velocity ω = I⁻¹ L, with the rest inertia
+// rotated by R).
+inline void lsm_region_update(const LsmData d) {
+    parallel_for("lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
+        const std::uint32_t begin = d.region_offsets[r], end = d.region_offsets[r + 1];
+        if (begin == end) return;
+        const Real M = d.region_mass[r];
+        const Vec3 c0 = d.region_c0[r];
+        const bool damp = d.objects[d.region_object[r]].damping_rate > Real(0);
+        Vec3 su{0, 0, 0}, sv{0, 0, 0}, sl{0, 0, 0};
+        Mat3 Au = mat3_zero();
+        // Displacements are taken relative to one member's (the anchor's): a translation of the
+        // region then gives exactly zero sums, and ū exactly the translation.
+        const std::uint32_t anchor = d.member_index[begin];
+        const Vec3 ua = d.position[d.store_of_slot[anchor]] - d.rest[anchor];
+        for (std::uint32_t k = begin; k < end; ++k) {
+            const std::uint32_t s = d.member_index[k];
+            const std::uint32_t i = d.store_of_slot[s];
+            const Real m = d.split_mass[s];
+            const Vec3 x0 = d.rest[s];
+            const Vec3 x = d.position[i];
+            const Vec3 mu = m * ((x - x0) - ua);
+            const Vec3 q = x0 - c0;
+            su += mu;
+            Au.m[0][0] += mu.x * q.x, Au.m[0][1] += mu.x * q.y, Au.m[0][2] += mu.x * q.z;
+            Au.m[1][0] += mu.y * q.x, Au.m[1][1] += mu.y * q.y, Au.m[1][2] += mu.y * q.z;
+            Au.m[2][0] += mu.z * q.x, Au.m[2][1] += mu.z * q.y, Au.m[2][2] += mu.z * q.z;
+            if (damp) {
+                const Vec3 mv = m * d.velocity[i];
+                sv += mv;
+                sl += cross(x - c0, mv);
+            }
+        }
+        const Mat3 A = sym_to_mat3(d.region_A0[r]) + Au;
+        const Quat R = polar_rotation(A, d.rotation[r]);
+        d.rotation[r] = R;
+        const Vec3 ubar = ua + su / M;
+        d.mean_displacement[r] = ubar;
+        if (damp) {
+            // L about c = c0 + ū: Σ m (x - c) × v = Σ m (x - c0) × v - ū × Σ m v.
+            const Vec3 L = sl - cross(ubar, sv);
+            const Quat Rinv{R.w, -R.x, -R.y, -R.z};
+            d.region_velocity[r] = sv / M;
+            d.region_omega[r] = quat_rotate(R, d.region_inertia_inv[r] * quat_rotate(Rinv, L));
+        }
+    });
+}
+
+// g_i - x_i for IBP slot s at position x with velocity v (see the top of the file); also the
+// mean rotation of its regions and, when `damp`, the mean over its regions of their rigid velocity
+// at x, minus v. Each region's term is formed as a difference before averaging: averaging large
+// equal values (a translated body's ū) and subtracting afterwards rounds the same way for every
+// particle, which shows up as a slow spurious acceleration.
+MW_INLINE Vec3 lsm_goal_offset(const LsmData& d, std::uint32_t s, Vec3 x, Vec3 v, Mat3& mean_rotation, bool damp,
+                               Vec3& rigid_velocity_offset) {
+    const Vec3 x0 = d.rest[s];
+    const Vec3 u = x - x0;
+    const std::uint32_t begin = d.regions_begin[s], end = d.regions_end[s];
+    Vec3 sum{0, 0, 0}, vr{0, 0, 0};
+    Mat3 rsum = mat3_zero();
+    for (std::uint32_t k = begin; k < end; ++k) {
+        const std::uint32_t r = d.member_index[k];
+        const Quat R = d.rotation[r];
+        const Vec3 c0 = d.region_c0[r];
+        const Vec3 ubar = d.mean_displacement[r];
+        const Vec3 q = x0 - c0;
+        sum += (quat_rotate(R, q) - q) + (ubar - u);
+        rsum = rsum + quat_to_mat3(R);
+        if (damp) vr += (d.region_velocity[r] - v) + cross(d.region_omega[r], x - (c0 + ubar));
+    }
+    const Real inv = end > begin ? Real(1) / Real(end - begin) : Real(0);
+    mean_rotation = inv * rsum;
+    rigid_velocity_offset = inv * vr;
+    return inv * sum;
+}
+
+// The IBP update: v += α (g - x)/Δt + Δt (f/m + gravity) (after damping), x += Δt v, then the
+// domain walls; pinned IBPs stay at their rest position with zero velocity.
+inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
+    parallel_for("lsm_update", d.ibp_count, [=] MW_HD(std::size_t si) {
+        const std::uint32_t s = static_cast<std::uint32_t>(si);
+        const std::uint32_t i = d.store_of_slot[s];
+        const LsmObjectParams obj = d.objects[d.object[s]];
+        Vec3 x = d.position[i];
+        Vec3 v = d.velocity[i];
+        const bool damp = obj.damping_rate > Real(0);
+        Mat3 mean_rotation;
+        Vec3 rigid_offset;
+        const Vec3 offset = lsm_goal_offset(d, s, x, v, mean_rotation, damp, rigid_offset);
+        d.mean_rotation[s] = mean_rotation;
+        if (d.pinned[s]) {
+            d.position[i] = d.rest[s];
+            d.velocity[i] = Vec3{0, 0, 0};
+            return;
+        }
+        if (damp) {
+            // v <- v_rigid + e^(-k Δt) (v - v_rigid)
+            v += (Real(1) - std::exp(-obj.damping_rate * p.dt)) * rigid_offset;
+        }
+        v += (obj.alpha / p.dt) * offset + p.dt * (d.force[s] / d.mass[s] + p.gravity);
+        x += p.dt * v;
+        // Domain walls: clamp into the box shrunk by the margin, drop the outward normal velocity,
+        // scale the tangential velocity by (1 - friction) on each wall touched.
+        const Real lo[3] = {p.domain_min.x + obj.margin, p.domain_min.y + obj.margin, p.domain_min.z + obj.margin};
+        const Real hi[3] = {p.domain_max.x - obj.margin, p.domain_max.y - obj.margin, p.domain_max.z - obj.margin};
+        Real* xc[3] = {&x.x, &x.y, &x.z};
+        Real* vc[3] = {&v.x, &v.y, &v.z};
+        for (int a = 0; a < 3; ++a) {
+            int side = 0;
+            if (*xc[a] < lo[a]) {
+                *xc[a] = lo[a];
+                if (*vc[a] < Real(0)) *vc[a] = Real(0);
+                side = 1;
+            } else if (*xc[a] > hi[a]) {
+                *xc[a] = hi[a];
+                if (*vc[a] > Real(0)) *vc[a] = Real(0);
+                side = 1;
+            }
+            if (side) {
+                const Real keep = Real(1) - obj.friction;
+                for (int b = 0; b < 3; ++b)
+                    if (b != a) *vc[b] *= keep;
+            }
+        }
+        d.position[i] = x;
+        d.velocity[i] = v;
+    });
+}
+
+// Goals without updating anything (tests): goal[s] = x_s + (g_s - x_s).
+inline void lsm_goals(const LsmData d, View<Vec3> goal) {
+    parallel_for("lsm_goals", d.ibp_count, [=] MW_HD(std::size_t si) {
+        const std::uint32_t s = static_cast<std::uint32_t>(si);
+        const Vec3 x = d.position[d.store_of_slot[s]];
+        Mat3 mean_rotation;
+        Vec3 rigid_offset;
+        goal[s] = x + lsm_goal_offset(d, s, x, Vec3{0, 0, 0}, mean_rotation, false, rigid_offset);
+    });
+}
+
+MW_BACKEND_END

@@ -1,0 +1,365 @@
+// Lattice shape matching, start-up part (host only, once): turns the solids of a SimulationSetup
+// into flat arrays indexed by a stable "solid slot", ready for upload (see solid_bodies.hpp).
+//
+// Slots: every IBP of every moving solid, then every SBP, then every GP. The particle store
+// re-sorts particles every step; a slot never changes, so all LSM data below is indexed by slot
+// and a per-step map slot -> store index finds the particle.
+//
+// Regions (METHOD.md, "Lattice shape matching"): an elastic object has one region per IBP,
+// centred on it, holding the IBPs within w lattice links, i.e. those reachable from the centre in
+// at most w steps through existing lattice neighbours (26-neighbourhood). Where the whole
+// (2w+1)³ cube exists this is the cube; elsewhere a breadth-first search keeps regions from
+// jumping across thin gaps (two fingers one lattice cell apart). Membership is symmetric, so the
+// regions containing IBP i are the members of i's own region, and elastic region r has slot r.
+// A rigid object has one region over all its IBPs (region ids after the IBP slots).
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "algorithms/simulation.hpp"
+#include "algorithms/vec3.hpp"
+#include "backend/errors.hpp"
+
+namespace mw {
+
+// Symmetric 3×3 matrix.
+struct SymMat3 {
+    Real xx, yy, zz, xy, xz, yz;
+};
+MW_INLINE Mat3 sym_to_mat3(const SymMat3& s) { return Mat3{{{s.xx, s.xy, s.xz}, {s.xy, s.yy, s.yz}, {s.xz, s.yz, s.zz}}}; }
+MW_INLINE Vec3 operator*(const SymMat3& s, Vec3 v) {
+    return Vec3{s.xx * v.x + s.xy * v.y + s.xz * v.z, s.xy * v.x + s.yy * v.y + s.yz * v.z,
+                s.xz * v.x + s.yz * v.y + s.zz * v.z};
+}
+
+// Per-object constants the kernels need (one small array, indexed by the object's position in
+// SimulationSetup::solids).
+struct LsmObjectParams {
+    Real alpha = 1;         // stiffness α
+    Real damping_rate = 0;  // 1/s
+    Real friction = 0;      // wall friction
+    Real margin = 0;        // IBPs stay this far inside the domain walls
+};
+
+struct SbpLink {
+    std::uint32_t corner[3];  // GP indices (0 .. gp_count) of the triangle's corners
+    Vec3 bary;
+    Real sign;  // +1 or -1: orients the deformed triangle's normal like the sampled one
+};
+
+struct LsmHostLayout {
+    std::size_t ibp_count = 0, sbp_count = 0, gp_count = 0;
+    std::vector<std::uint32_t> scene_index;  // per slot: IBPs, then SBPs, then GPs
+    // IBPs
+    std::vector<Vec3> ibp_rest;
+    std::vector<Real> ibp_mass, ibp_split_mass;
+    std::vector<std::int32_t> ibp_object;
+    std::vector<std::uint8_t> ibp_pinned;
+    std::vector<std::uint32_t> ibp_regions_begin, ibp_regions_end;  // into member_index (region ids)
+    // Regions: members of region r are member_index[region_offsets[r] .. region_offsets[r+1]);
+    // member_index continues with the region ids of rigid objects' IBPs.
+    std::vector<std::uint32_t> region_offsets;
+    std::vector<std::uint32_t> member_index;
+    std::vector<Real> region_mass;
+    std::vector<Vec3> region_c0;
+    std::vector<SymMat3> region_A0, region_inertia_inv;
+    std::vector<std::int32_t> region_object;
+    // GPs: normalised weights of Eq. 19, links are IBP slots
+    std::vector<Vec3> gp_rest;
+    std::vector<std::uint32_t> gp_offsets, gp_links;
+    std::vector<Real> gp_weights;
+    // SBPs
+    std::vector<SbpLink> sbp;
+    std::vector<Vec3> sbp_normal;
+    std::vector<LsmObjectParams> objects;
+
+    std::size_t region_count() const { return region_mass.size(); }
+    std::size_t slot_count() const { return ibp_count + sbp_count + gp_count; }
+};
+
+namespace lsm_detail {
+
+// Members (local IBP indices, increasing) of the region centred on each IBP of one object.
+inline void build_elastic_regions(const std::vector<std::array<int, 3>>& lattice, int w,
+                                  std::vector<std::vector<std::uint32_t>>& members) {
+    const std::size_t n = lattice.size();
+    int lo[3] = {lattice[0][0], lattice[0][1], lattice[0][2]}, hi[3] = {lo[0], lo[1], lo[2]};
+    for (const auto& c : lattice)
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+    const long dims[3] = {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1};
+    if (double(dims[0]) * double(dims[1]) * double(dims[2]) > 4e8)
+        throw InputError("an object's lattice is too large for LSM region building");
+    std::vector<std::int32_t> grid(std::size_t(dims[0] * dims[1] * dims[2]), -1);
+    auto cell = [&](long i, long j, long k) { return std::size_t((k * dims[1] + j) * dims[0] + i); };
+    for (std::size_t p = 0; p < n; ++p) {
+        const long i = lattice[p][0] - lo[0], j = lattice[p][1] - lo[1], k = lattice[p][2] - lo[2];
+        if (grid[cell(i, j, k)] >= 0) throw InputError("two IBPs of one object share a lattice point");
+        grid[cell(i, j, k)] = std::int32_t(p);
+    }
+    auto at = [&](long i, long j, long k) -> std::int32_t {
+        if (i < 0 || j < 0 || k < 0 || i >= dims[0] || j >= dims[1] || k >= dims[2]) return -1;
+        return grid[cell(i, j, k)];
+    };
+    members.assign(n, {});
+    std::vector<int> depth(grid.size(), -1);  // BFS marks, reset after each search
+    std::vector<std::size_t> touched;
+    for (std::size_t p = 0; p < n; ++p) {
+        const long ci = lattice[p][0] - lo[0], cj = lattice[p][1] - lo[1], ck = lattice[p][2] - lo[2];
+        std::vector<std::uint32_t>& m = members[p];
+        bool full = true;
+        for (long k = ck - w; k <= ck + w && full; ++k)
+            for (long j = cj - w; j <= cj + w && full; ++j)
+                for (long i = ci - w; i <= ci + w && full; ++i) full = at(i, j, k) >= 0;
+        if (full) {
+            for (long k = ck - w; k <= ck + w; ++k)
+                for (long j = cj - w; j <= cj + w; ++j)
+                    for (long i = ci - w; i <= ci + w; ++i) m.push_back(std::uint32_t(at(i, j, k)));
+        } else {
+            std::vector<std::uint32_t> frontier{std::uint32_t(p)};
+            depth[cell(ci, cj, ck)] = 0;
+            touched.push_back(cell(ci, cj, ck));
+            m.push_back(std::uint32_t(p));
+            for (int d = 1; d <= w; ++d) {
+                std::vector<std::uint32_t> next;
+                for (std::uint32_t q : frontier) {
+                    const long qi = lattice[q][0] - lo[0], qj = lattice[q][1] - lo[1], qk = lattice[q][2] - lo[2];
+                    for (long dk = -1; dk <= 1; ++dk)
+                        for (long dj = -1; dj <= 1; ++dj)
+                            for (long di = -1; di <= 1; ++di) {
+                                const std::int32_t r = at(qi + di, qj + dj, qk + dk);
+                                if (r < 0) continue;
+                                const std::size_t c = cell(qi + di, qj + dj, qk + dk);
+                                if (depth[c] >= 0) continue;
+                                depth[c] = d;
+                                touched.push_back(c);
+                                next.push_back(std::uint32_t(r));
+                                m.push_back(std::uint32_t(r));
+                            }
+                }
+                frontier.swap(next);
+            }
+            for (std::size_t c : touched) depth[c] = -1;
+            touched.clear();
+        }
+        std::sort(m.begin(), m.end());
+    }
+}
+
+// Regularised inverse of a symmetric positive semi-definite matrix (in double): line-like
+// regions have no inertia about their axis, and no angular momentum about it either.
+inline SymMat3 regularised_inverse(double xx, double yy, double zz, double xy, double xz, double yz) {
+    const double reg = 1e-4 * (xx + yy + zz) + 1e-300;
+    xx += reg, yy += reg, zz += reg;
+    const double c00 = yy * zz - yz * yz, c01 = xz * yz - xy * zz, c02 = xy * yz - xz * yy;
+    const double c11 = xx * zz - xz * xz, c12 = xy * xz - xx * yz, c22 = xx * yy - xy * xy;
+    const double det = xx * c00 + xy * c01 + xz * c02;
+    const double s = det != 0 ? 1.0 / det : 0.0;
+    return SymMat3{Real(c00 * s), Real(c11 * s), Real(c22 * s), Real(c01 * s), Real(c02 * s), Real(c12 * s)};
+}
+
+}  // namespace lsm_detail
+
+// Builds the slot arrays and regions of every moving solid (elastic or rigid) of `setup`.
+inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup) {
+    LsmHostLayout L;
+    const std::size_t n_particles = setup.position.size();
+    auto check_index = [&](std::uint32_t i, const std::string& what, const std::string& name) {
+        if (i >= n_particles) throw InputError("solid '" + name + "': " + what + " index out of range");
+    };
+    std::vector<std::size_t> ibp_base(setup.solids.size()), sbp_base(setup.solids.size()), gp_base(setup.solids.size());
+    for (std::size_t o = 0; o < setup.solids.size(); ++o) {
+        const SolidSetup& s = setup.solids[o];
+        if (s.kind == SolidKind::kStatic) continue;
+        ibp_base[o] = L.ibp_count;
+        L.ibp_count += s.ibp.size();
+    }
+    for (std::size_t o = 0; o < setup.solids.size(); ++o) {
+        const SolidSetup& s = setup.solids[o];
+        if (s.kind == SolidKind::kStatic) continue;
+        sbp_base[o] = L.sbp_count;
+        L.sbp_count += s.sbp.size();
+        gp_base[o] = L.gp_count;
+        L.gp_count += s.gp.size();
+    }
+    L.objects.resize(setup.solids.size());
+    L.region_offsets.assign(L.ibp_count + 1, 0);
+    L.region_mass.assign(L.ibp_count, 0);
+    L.region_c0.assign(L.ibp_count, Vec3{0, 0, 0});
+    L.region_A0.assign(L.ibp_count, SymMat3{0, 0, 0, 0, 0, 0});
+    L.region_inertia_inv.assign(L.ibp_count, SymMat3{0, 0, 0, 0, 0, 0});
+    L.region_object.assign(L.ibp_count, 0);
+    L.ibp_rest.resize(L.ibp_count);
+    L.ibp_mass.resize(L.ibp_count);
+    L.ibp_split_mass.resize(L.ibp_count);
+    L.ibp_object.resize(L.ibp_count);
+    L.ibp_pinned.assign(L.ibp_count, 0);
+    L.ibp_regions_begin.resize(L.ibp_count);
+    L.ibp_regions_end.resize(L.ibp_count);
+    L.scene_index.resize(L.slot_count());
+
+    // Members of every region (elastic: per IBP; rigid: appended after the IBP slots).
+    std::vector<std::vector<std::uint32_t>> region_members(L.ibp_count);  // slots
+    std::vector<std::size_t> rigid_objects;
+    for (std::size_t o = 0; o < setup.solids.size(); ++o) {
+        const SolidSetup& s = setup.solids[o];
+        if (s.kind == SolidKind::kStatic) continue;
+        if (s.ibp.empty()) throw InputError("solid '" + s.name + "' has no inner particles (IBPs); make it larger or decrease the spacing");
+        if (s.lattice.size() != s.ibp.size()) throw InputError("solid '" + s.name + "': lattice and ibp lists differ in length");
+        if (!s.pinned.empty() && s.pinned.size() != s.ibp.size()) throw InputError("solid '" + s.name + "': pinned list has the wrong length");
+        if (!(s.stiffness > 0 && s.stiffness <= 1)) throw InputError("solid '" + s.name + "': stiffness α must be in (0, 1]");
+        if (!(s.density > 0) || !(s.spacing > 0)) throw InputError("solid '" + s.name + "': density and spacing must be > 0");
+        if (s.region_half_width < 1) throw InputError("solid '" + s.name + "': region half-width w must be >= 1");
+        LsmObjectParams& P = L.objects[o];
+        P.alpha = s.kind == SolidKind::kRigid ? Real(1) : s.stiffness;
+        P.damping_rate = s.damping;
+        P.friction = s.wall_friction;
+        P.margin = Real(0.5) * s.spacing;
+        const Real mass = s.density * s.spacing * s.spacing * s.spacing;
+        const std::size_t base = ibp_base[o];
+        for (std::size_t k = 0; k < s.ibp.size(); ++k) {
+            check_index(s.ibp[k], "ibp", s.name);
+            L.scene_index[base + k] = s.ibp[k];
+            L.ibp_rest[base + k] = setup.position[s.ibp[k]];
+            L.ibp_mass[base + k] = mass;
+            L.ibp_object[base + k] = std::int32_t(o);
+            L.ibp_pinned[base + k] = s.pinned.empty() ? 0 : s.pinned[k];
+        }
+        if (s.kind == SolidKind::kElastic) {
+            std::vector<std::vector<std::uint32_t>> local;
+            lsm_detail::build_elastic_regions(s.lattice, s.region_half_width, local);
+            for (std::size_t k = 0; k < local.size(); ++k) {
+                for (std::uint32_t& m : local[k]) m += std::uint32_t(base);
+                region_members[base + k] = std::move(local[k]);
+                L.region_object[base + k] = std::int32_t(o);
+            }
+        } else {
+            rigid_objects.push_back(o);
+            std::vector<std::uint32_t> all(s.ibp.size());
+            for (std::size_t k = 0; k < all.size(); ++k) all[k] = std::uint32_t(base + k);
+            region_members.push_back(std::move(all));
+            L.region_object.push_back(std::int32_t(o));
+        }
+    }
+    const std::size_t n_regions = region_members.size();
+    L.region_offsets.assign(n_regions + 1, 0);
+    L.region_mass.resize(n_regions);
+    L.region_c0.resize(n_regions);
+    L.region_A0.resize(n_regions);
+    L.region_inertia_inv.resize(n_regions);
+    std::vector<std::uint32_t> regions_of_count(L.ibp_count, 0);
+    for (std::size_t r = 0; r < n_regions; ++r) {
+        L.region_offsets[r + 1] = L.region_offsets[r] + std::uint32_t(region_members[r].size());
+        for (std::uint32_t m : region_members[r]) ++regions_of_count[m];
+    }
+    if (double(L.region_offsets[n_regions]) + double(L.ibp_count) > 4.0e9)
+        throw InputError("too many LSM region members (more than 2^32); use a smaller region half-width w");
+    L.member_index.reserve(L.region_offsets[n_regions] + L.ibp_count);
+    for (auto& m : region_members) L.member_index.insert(L.member_index.end(), m.begin(), m.end());
+    for (std::size_t s = 0; s < L.ibp_count; ++s) L.ibp_split_mass[s] = L.ibp_mass[s] / Real(regions_of_count[s]);
+    // Regions containing each IBP: its own region's members (elastic), or its object's region.
+    for (std::size_t s = 0; s < L.ibp_count; ++s) {
+        if (!region_members[s].empty()) {
+            L.ibp_regions_begin[s] = L.region_offsets[s];
+            L.ibp_regions_end[s] = L.region_offsets[s + 1];
+        }
+    }
+    for (std::size_t k = 0; k < rigid_objects.size(); ++k) {
+        const std::size_t o = rigid_objects[k];
+        const std::uint32_t region = std::uint32_t(L.ibp_count + k);
+        for (std::size_t j = 0; j < setup.solids[o].ibp.size(); ++j) {
+            const std::size_t s = ibp_base[o] + j;
+            L.ibp_regions_begin[s] = std::uint32_t(L.member_index.size());
+            L.member_index.push_back(region);
+            L.ibp_regions_end[s] = std::uint32_t(L.member_index.size());
+        }
+    }
+    // Rest sums per region, in double.
+    for (std::size_t r = 0; r < n_regions; ++r) {
+        double M = 0, c[3] = {0, 0, 0};
+        for (std::uint32_t m : region_members[r]) {
+            const double w = L.ibp_split_mass[m];
+            const Vec3 x = L.ibp_rest[m];
+            M += w, c[0] += w * x.x, c[1] += w * x.y, c[2] += w * x.z;
+        }
+        if (M > 0) c[0] /= M, c[1] /= M, c[2] /= M;
+        double a[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy xz yz
+        for (std::uint32_t m : region_members[r]) {
+            const double w = L.ibp_split_mass[m];
+            const Vec3 x = L.ibp_rest[m];
+            const double q[3] = {x.x - c[0], x.y - c[1], x.z - c[2]};
+            a[0] += w * q[0] * q[0], a[1] += w * q[1] * q[1], a[2] += w * q[2] * q[2];
+            a[3] += w * q[0] * q[1], a[4] += w * q[0] * q[2], a[5] += w * q[1] * q[2];
+        }
+        L.region_mass[r] = Real(M);
+        // Nudge c0 (in Real) so that Σ m̃ (x0 - c0), evaluated in Real as the kernels do, is as
+        // close to zero as rounding allows: the goals' momentum balance rests on that sum, and
+        // its rounding error, divided by Δt, would otherwise show up as a slow drift of momentum.
+        Vec3 c0{Real(c[0]), Real(c[1]), Real(c[2])};
+        for (int pass = 0; pass < 3 && M > 0; ++pass) {
+            double e[3] = {0, 0, 0};
+            for (std::uint32_t m : region_members[r]) {
+                const Vec3 q = L.ibp_rest[m] - c0;
+                const double w = L.ibp_split_mass[m];
+                e[0] += w * double(q.x), e[1] += w * double(q.y), e[2] += w * double(q.z);
+            }
+            c0 = c0 + Vec3{Real(e[0] / M), Real(e[1] / M), Real(e[2] / M)};
+        }
+        L.region_c0[r] = c0;
+        L.region_A0[r] = SymMat3{Real(a[0]), Real(a[1]), Real(a[2]), Real(a[3]), Real(a[4]), Real(a[5])};
+        const double tr = a[0] + a[1] + a[2];
+        L.region_inertia_inv[r] = lsm_detail::regularised_inverse(tr - a[0], tr - a[1], tr - a[2], -a[3], -a[4], -a[5]);
+    }
+    // GPs and SBPs.
+    L.gp_offsets.assign(1, 0);
+    L.gp_rest.reserve(L.gp_count);
+    L.sbp.reserve(L.sbp_count);
+    for (std::size_t o = 0; o < setup.solids.size(); ++o) {
+        const SolidSetup& s = setup.solids[o];
+        if (s.kind == SolidKind::kStatic) continue;
+        if (s.gp_offsets.size() != s.gp.size() + 1 || s.gp_links.size() != s.gp_weights.size())
+            throw InputError("solid '" + s.name + "': malformed GP links");
+        for (std::size_t g = 0; g < s.gp.size(); ++g) {
+            check_index(s.gp[g], "gp", s.name);
+            L.scene_index[L.ibp_count + L.sbp_count + gp_base[o] + g] = s.gp[g];
+            L.gp_rest.push_back(setup.position[s.gp[g]]);
+            double total = 0;
+            for (int k = s.gp_offsets[g]; k < s.gp_offsets[g + 1]; ++k) total += s.gp_weights[std::size_t(k)];
+            const int count = s.gp_offsets[g + 1] - s.gp_offsets[g];
+            if (count <= 0) throw InputError("solid '" + s.name + "': a GP has no IBP link");
+            for (int k = s.gp_offsets[g]; k < s.gp_offsets[g + 1]; ++k) {
+                const int d = s.gp_links[std::size_t(k)];
+                if (d < 0 || std::size_t(d) >= s.ibp.size()) throw InputError("solid '" + s.name + "': GP link out of range");
+                L.gp_links.push_back(std::uint32_t(ibp_base[o] + std::size_t(d)));
+                L.gp_weights.push_back(total > 0 ? Real(s.gp_weights[std::size_t(k)] / total) : Real(1.0 / count));
+            }
+            L.gp_offsets.push_back(std::uint32_t(L.gp_links.size()));
+        }
+        if (s.sbp_corners.size() != s.sbp.size() || s.sbp_barycentric.size() != s.sbp.size() ||
+            s.sbp_normal.size() != s.sbp.size())
+            throw InputError("solid '" + s.name + "': SBP lists differ in length");
+        for (std::size_t k = 0; k < s.sbp.size(); ++k) {
+            check_index(s.sbp[k], "sbp", s.name);
+            L.scene_index[L.ibp_count + sbp_base[o] + k] = s.sbp[k];
+            SbpLink link;
+            Vec3 corner[3];
+            for (int c = 0; c < 3; ++c) {
+                const int g = s.sbp_corners[k][c];
+                if (g < 0 || std::size_t(g) >= s.gp.size()) throw InputError("solid '" + s.name + "': SBP corner out of range");
+                link.corner[c] = std::uint32_t(gp_base[o] + std::size_t(g));
+                corner[c] = setup.position[s.gp[std::size_t(g)]];
+            }
+            link.bary = s.sbp_barycentric[k];
+            const Vec3 n = cross(corner[1] - corner[0], corner[2] - corner[0]);
+            link.sign = dot(n, s.sbp_normal[k]) < 0 ? Real(-1) : Real(1);
+            L.sbp.push_back(link);
+            L.sbp_normal.push_back(s.sbp_normal[k]);
+        }
+    }
+    return L;
+}
+
+}  // namespace mw

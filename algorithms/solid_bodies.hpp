@@ -1,0 +1,247 @@
+// The moving solids of a simulation (elastic and rigid objects) on one backend: their LSM state,
+// the stable slot of each solid particle, and the per-step work (METHOD.md, step 6), called once
+// per step from time_step.hpp.
+//
+// Slots: the particle store re-sorts particles every step, so every solid particle (IBP, SBP,
+// GP) carries its fixed slot in a persistent store field `solid_slot` (-1 for others), and after
+// each sort one kernel rebuilds store_of_slot[slot] = store index. All LSM arrays are indexed by
+// slot; kernels read and write positions and velocities in the store through that map.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "algorithms/lsm.hpp"
+#include "algorithms/particle_store.hpp"
+#include "algorithms/particle_types.hpp"
+#include "algorithms/pcisph.hpp"
+#include "algorithms/solid_interpolation.hpp"
+
+MW_BACKEND_BEGIN
+
+struct SolidSummary {
+    double kinetic_energy = 0;
+    Real max_speed2 = 0;
+    std::uint32_t first_bad = 0xffffffffu;  // slot of the first non-finite IBP
+};
+
+// Rebuilds store_of_slot from the store's solid_slot field (particles [0, count)).
+inline void build_slot_map(std::size_t count, View<const std::int32_t> solid_slot, View<std::uint32_t> store_of_slot) {
+    parallel_for("solid_slot_map", count, [=] MW_HD(std::size_t i) {
+        const std::int32_t s = solid_slot[i];
+        if (s >= 0) store_of_slot[static_cast<std::size_t>(s)] = static_cast<std::uint32_t>(i);
+    });
+}
+
+inline SolidSummary summarize_solids(const LsmData d) {
+    const MotionSummary m = transform_reduce(
+        "solid_summary", d.ibp_count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t s) {
+            const std::uint32_t i = d.store_of_slot[s];
+            const Vec3 v = d.velocity[i];
+            const Real v2 = norm2(v);
+            const bool finite = is_finite(v) && is_finite(d.position[i]);
+            return MotionSummary{finite ? 0.5 * double(d.mass[s]) * double(v2) : 0.0, finite ? v2 : Real(0),
+                                 finite ? 0xffffffffu : static_cast<std::uint32_t>(s)};
+        });
+    return SolidSummary{m.kinetic_energy, m.max_speed2, m.first_bad};
+}
+
+class SolidBodies {
+   public:
+    // Registers the slot field in `store` (already sized and filled in the order `order`, the
+    // scene index of each store entry) and uploads the layout built from `setup`.
+    void init(const SimulationSetup& setup, const std::vector<std::uint32_t>& order, ParticleStore& store) {
+        LsmHostLayout L = build_lsm_layout(setup);
+        ibp_count_ = L.ibp_count;
+        sbp_count_ = L.sbp_count;
+        gp_count_ = L.gp_count;
+        if (ibp_count_ == 0) return;
+        std::vector<std::int32_t> slot_of_scene(setup.position.size(), -1);
+        for (std::size_t s = 0; s < L.scene_index.size(); ++s) {
+            if (slot_of_scene[L.scene_index[s]] >= 0)
+                throw InputError("simulation setup: a particle belongs to two solid objects");
+            slot_of_scene[L.scene_index[s]] = static_cast<std::int32_t>(s);
+        }
+        std::vector<std::int32_t> slot(order.size());
+        for (std::size_t k = 0; k < order.size(); ++k) {
+            slot[k] = slot_of_scene[order[k]];
+            if (slot[k] >= 0 && k >= store.moving_count())
+                throw InputError("simulation setup: a particle of a moving solid has the static boundary type");
+        }
+        solid_slot_ = &store.add<std::int32_t>("solid_slot", FieldLife::kPersistent);
+        solid_slot_->upload(slot);
+        store_of_slot_.resize(L.slot_count());
+        rest_.upload(L.ibp_rest);
+        mass_.upload(L.ibp_mass);
+        split_mass_.upload(L.ibp_split_mass);
+        object_.upload(L.ibp_object);
+        pinned_.upload(L.ibp_pinned);
+        regions_begin_.upload(L.ibp_regions_begin);
+        regions_end_.upload(L.ibp_regions_end);
+        force_.resize(ibp_count_);
+        force_.fill(Vec3{0, 0, 0});
+        mean_rotation_.resize(ibp_count_);
+        mean_rotation_.fill(mat3_identity());
+        region_offsets_.upload(L.region_offsets);
+        member_index_.upload(L.member_index);
+        region_mass_.upload(L.region_mass);
+        region_c0_.upload(L.region_c0);
+        region_A0_.upload(L.region_A0);
+        region_inertia_inv_.upload(L.region_inertia_inv);
+        region_object_.upload(L.region_object);
+        const std::size_t regions = L.region_count();
+        rotation_.resize(regions);
+        rotation_.fill(quat_identity());
+        mean_displacement_.resize(regions);
+        mean_displacement_.fill(Vec3{0, 0, 0});
+        bool any_damping = false;
+        for (const auto& o : L.objects) any_damping = any_damping || o.damping_rate > 0;
+        if (any_damping) {
+            region_velocity_.resize(regions);
+            region_omega_.resize(regions);
+            region_velocity_.fill(Vec3{0, 0, 0});
+            region_omega_.fill(Vec3{0, 0, 0});
+        }
+        objects_.upload(L.objects);
+        gp_rest_.upload(L.gp_rest);
+        gp_offsets_.upload(L.gp_offsets);
+        gp_links_.upload(L.gp_links);
+        gp_weights_.upload(L.gp_weights);
+        sbp_.upload(L.sbp);
+        sbp_normal_.upload(L.sbp_normal);
+        members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
+    }
+
+    bool active() const { return ibp_count_ > 0; }
+    std::size_t ibp_count() const { return ibp_count_; }
+    std::size_t region_member_count() const { return members_total_; }
+
+    // After the neighbour sort: slot -> store index.
+    void update_slot_map(const ParticleStore& store) {
+        build_slot_map(store.moving_count(), solid_slot_->cview(), store_of_slot_.view());
+    }
+
+    // One LSM step (the slot map must be current): regions, IBP update, GPs, SBPs.
+    SolidSummary step(ParticleStore& store, Real dt, Vec3 gravity, Vec3 domain_min, Vec3 domain_max) {
+        const LsmData d = data(store);
+        lsm_region_update(d);
+        LsmStepParams p;
+        p.dt = dt;
+        p.gravity = gravity;
+        p.domain_min = domain_min;
+        p.domain_max = domain_max;
+        lsm_particle_update(d, p);
+        const InterpolationData g = interpolation(store);
+        interpolate_geometry(g, dt);
+        interpolate_surface(g);
+        return summarize_solids(d);
+    }
+
+    // The current goal of every IBP (slot order), without changing anything but the warm-start
+    // rotations (tests).
+    std::vector<Vec3> goals(ParticleStore& store) {
+        update_slot_map(store);
+        const LsmData d = data(store);
+        lsm_region_update(d);
+        DeviceArray<Vec3> goal(ibp_count_);
+        lsm_goals(d, goal.view());
+        return goal.to_host();
+    }
+
+    // Scene index of the IBP in a slot is not kept on the device; this gives the store index.
+    std::uint32_t store_index_of_slot(std::size_t slot) const {
+        std::uint32_t i = 0;
+        store_of_slot_.download_range(&i, slot, 1);
+        return i;
+    }
+
+    View<Vec3> force() { return force_.view(); }
+    View<const Vec3> sbp_normals() const { return sbp_normal_.cview(); }
+
+    std::size_t bytes() const {
+        return store_of_slot_.bytes() + rest_.bytes() + mass_.bytes() + split_mass_.bytes() + object_.bytes() +
+               pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() +
+               mean_rotation_.bytes() + region_offsets_.bytes() + member_index_.bytes() + region_mass_.bytes() +
+               region_c0_.bytes() + region_A0_.bytes() + region_inertia_inv_.bytes() + region_object_.bytes() +
+               rotation_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
+               objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
+               sbp_.bytes() + sbp_normal_.bytes();
+    }
+
+    LsmData data(ParticleStore& store) {
+        LsmData d;
+        d.position = store.position.view().data();
+        d.velocity = store.velocity.view().data();
+        d.store_of_slot = store_of_slot_.view().data();
+        d.ibp_count = static_cast<std::uint32_t>(ibp_count_);
+        d.rest = rest_.view().data();
+        d.mass = mass_.view().data();
+        d.split_mass = split_mass_.view().data();
+        d.object = object_.view().data();
+        d.pinned = pinned_.view().data();
+        d.regions_begin = regions_begin_.view().data();
+        d.regions_end = regions_end_.view().data();
+        d.force = force_.view().data();
+        d.mean_rotation = mean_rotation_.view().data();
+        d.region_count = static_cast<std::uint32_t>(region_mass_.size());
+        d.region_offsets = region_offsets_.view().data();
+        d.member_index = member_index_.view().data();
+        d.region_mass = region_mass_.view().data();
+        d.region_c0 = region_c0_.view().data();
+        d.region_A0 = region_A0_.view().data();
+        d.region_inertia_inv = region_inertia_inv_.view().data();
+        d.region_object = region_object_.view().data();
+        d.rotation = rotation_.view().data();
+        d.mean_displacement = mean_displacement_.view().data();
+        d.region_velocity = region_velocity_.view().data();
+        d.region_omega = region_omega_.view().data();
+        d.objects = objects_.view().data();
+        return d;
+    }
+
+    InterpolationData interpolation(ParticleStore& store) {
+        InterpolationData g;
+        g.position = store.position.view().data();
+        g.velocity = store.velocity.view().data();
+        g.store_of_slot = store_of_slot_.view().data();
+        g.ibp_rest = rest_.view().data();
+        g.mean_rotation = mean_rotation_.view().data();
+        g.sbp_first = static_cast<std::uint32_t>(ibp_count_);
+        g.gp_first = static_cast<std::uint32_t>(ibp_count_ + sbp_count_);
+        g.gp_count = static_cast<std::uint32_t>(gp_count_);
+        g.sbp_count = static_cast<std::uint32_t>(sbp_count_);
+        g.gp_rest = gp_rest_.view().data();
+        g.gp_offsets = gp_offsets_.view().data();
+        g.gp_links = gp_links_.view().data();
+        g.gp_weights = gp_weights_.view().data();
+        g.sbp = sbp_.view().data();
+        g.sbp_normal = sbp_normal_.view().data();
+        return g;
+    }
+
+   private:
+    std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0;
+    DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
+    DeviceArray<std::uint32_t> store_of_slot_;
+    DeviceArray<Vec3> rest_;
+    DeviceArray<Real> mass_, split_mass_;
+    DeviceArray<std::int32_t> object_;
+    DeviceArray<std::uint8_t> pinned_;
+    DeviceArray<std::uint32_t> regions_begin_, regions_end_;
+    DeviceArray<Vec3> force_;
+    DeviceArray<Mat3> mean_rotation_;
+    DeviceArray<std::uint32_t> region_offsets_, member_index_;
+    DeviceArray<Real> region_mass_;
+    DeviceArray<Vec3> region_c0_;
+    DeviceArray<SymMat3> region_A0_, region_inertia_inv_;
+    DeviceArray<std::int32_t> region_object_;
+    DeviceArray<Quat> rotation_;
+    DeviceArray<Vec3> mean_displacement_, region_velocity_, region_omega_;
+    DeviceArray<LsmObjectParams> objects_;
+    DeviceArray<Vec3> gp_rest_;
+    DeviceArray<std::uint32_t> gp_offsets_, gp_links_;
+    DeviceArray<Real> gp_weights_;
+    DeviceArray<SbpLink> sbp_;
+    DeviceArray<Vec3> sbp_normal_;
+};
+
+MW_BACKEND_END

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# `make bench`: runs every benchmark on every backend available and writes one report,
+# bench/results/DATE-DEVICE.md, with the date, the device and the commands that produced it.
+# Usage: bench/run_benchmarks.sh [BUILD_DIR] [extra bench_fluid options, e.g. --quick or --large]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+shift || true
+threads=${BENCH_THREADS:-$(nproc)}
+date=$(date +%Y-%m-%d)
+gpu=$("$build/meltwater" backends --json 2>/dev/null | python3 -c 'import json,sys; b=json.load(sys.stdin); c=[x for x in b["backends"] if x["name"]=="cuda"]; print("cuda" if c and c[0]["available"] else "")' 2>/dev/null || true)
+if [[ -n "$gpu" ]]; then
+  device=$(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | head -1 | tr ' ' '-' | tr -cd 'A-Za-z0-9-')
+else
+  device="cpu-${threads}threads"
+fi
+out="bench/results/${date}-${device}.md"
+mkdir -p bench/results
+{
+  echo "# Benchmarks, ${date}, ${device}"
+  echo
+  echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
+  echo "Command: \`make bench\` (bench/run_benchmarks.sh $build $*), BENCH_THREADS=${threads}"
+  echo
+} > "$out"
+echo "## Fluid, OpenMP (${threads} threads)" >> "$out"
+"$build/bench_fluid" --backend openmp --threads "$threads" --out "$out" "$@"
+if [[ -n "$gpu" ]]; then
+  echo "## Fluid, CUDA" >> "$out"
+  "$build/bench_fluid" --backend cuda --large --out "$out" "$@"
+fi
+if [[ -x "$build/bench_lsm" ]]; then
+  echo "## LSM" >> "$out"
+  "$build/bench_lsm" --out "$out" ${gpu:+--backend cuda} || echo "bench_lsm failed" >> "$out"
+fi
+if [[ -x "$build/bench_sampling" ]]; then
+  echo "## Sampling (bunny, 0.5 m)" >> "$out"
+  "$build/bench_sampling" --threads "$threads" --out "$out.sampling.tmp" && cat "$out.sampling.tmp" >> "$out" && rm -f "$out.sampling.tmp"
+fi
+echo "bench: report written to $out"

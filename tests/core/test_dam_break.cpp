@@ -1,0 +1,51 @@
+// Dam break against Martin & Moyce (1952): column a wide and 2a high, front Z = x/a against
+// T = t sqrt(2g/a) (table in METHOD.md).
+//
+// Measured with free-slip walls and no tuning (r0 = a/20; the same numbers at a/10 and a/40):
+// the front matches at T = 0.41, then leads the experiment by up to about 21% around T = 1.2 and
+// by about 11% at T = 2.5, advancing at the experiment's speed from T = 1.8 on. The early lead
+// is the known lag of the experiment's first points (the gate was lifted by hand); wall friction
+// (fluid.wall_viscosity) narrows the later gap but not the early one. So the test asserts: the
+// early front within 10%; the late front speed within 10%; the front never behind the experiment
+// by more than 10% and never ahead by more than 25%.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "backend/backend_registry.hpp"
+#include "test_setups.hpp"
+
+using namespace mw;
+
+TEST_CASE("dam break surge front follows Martin & Moyce") {
+    const Real a = 0.2f, r0 = 0.01f, depth = 0.04f;
+    SimulationSetup setup =
+        test::fluid_in_box({0, 0, 0}, {5 * a, 2.5f * a, depth}, {0, 0, 0}, {a, 2 * a, depth}, r0, 0.001f);
+    auto sim = create_openmp_simulation(setup, 0);
+    const double T[] = {0.41, 0.84, 1.19, 1.43, 1.63, 1.83, 1.98, 2.20, 2.32, 2.51};
+    const double Z[] = {1.11, 1.22, 1.44, 1.67, 1.89, 2.11, 2.33, 2.56, 2.78, 3.00};
+    const int samples = 10;
+    const double time_scale = std::sqrt(2 * 9.81 / a);
+    double simulated[samples], at_T[samples];
+    HostParticles p;
+    for (int k = 0; k < samples; ++k) {
+        while (sim->time() * time_scale < T[k]) sim->step();
+        sim->download(p);
+        double front = 0;
+        for (std::size_t i = 0; i < p.position.size(); ++i)
+            if (p.type[i] == kFluid) front = std::max(front, double(p.position[i].x));
+        simulated[k] = (front + r0 / 2) / a;
+        at_T[k] = sim->time() * time_scale;
+        const double deviation = (simulated[k] - Z[k]) / Z[k];
+        MESSAGE("T " << at_T[k] << ": Z " << simulated[k] << " (Martin & Moyce " << Z[k] << ", " << 100 * deviation
+                     << "%)");
+        CHECK(deviation > -0.10);
+        CHECK(deviation < 0.25);
+    }
+    CHECK(std::fabs(simulated[0] - Z[0]) / Z[0] < 0.10);
+    const double speed = (simulated[9] - simulated[5]) / (at_T[9] - at_T[5]);
+    const double experiment_speed = (Z[9] - Z[5]) / (T[9] - T[5]);
+    MESSAGE("front speed dZ/dT for T in [1.83, 2.51]: " << speed << " (Martin & Moyce " << experiment_speed << ")");
+    CHECK(std::fabs(speed - experiment_speed) / experiment_speed < 0.10);
+    CHECK(sim->last_report().lost_particles == 0);  // the walls held: nothing leaked
+}
