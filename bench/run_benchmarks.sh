@@ -30,8 +30,8 @@ if [[ -n "$gpu" ]]; then
   "$build/bench_fluid" --backend cuda --large --out "$out" "$@"
 fi
 if [[ -x "$build/bench_lsm" ]]; then
-  echo "## LSM" >> "$out"
-  "$build/bench_lsm" --out "$out" ${gpu:+--backend cuda} || echo "bench_lsm failed" >> "$out"
+  echo "## LSM (elastic cubes, w = 2; every backend available)" >> "$out"
+  OMP_NUM_THREADS=$threads "$build/bench_lsm" >> "$out" || echo "bench_lsm failed" >> "$out"
 fi
 if [[ -x "$build/bench_sampling" ]]; then
   echo "## Sampling (bunny, 0.5 m)" >> "$out"
