@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "backend/config.hpp"
+#include "backend/device_array.hpp"
 #include "backend/errors.hpp"
 #include "backend/memory_ledger.hpp"
 #include "backend/reduce_ops.hpp"
@@ -53,96 +54,35 @@ void* cub_workspace(std::size_t bytes);
 // A small pinned host buffer for reduction results, so a reduction costs one small copy.
 void* pinned_scratch(std::size_t bytes);
 
-template <class T>
-class DeviceArray {
-   public:
-    DeviceArray() = default;
-    explicit DeviceArray(std::size_t n) { resize(n); }
-    DeviceArray(const DeviceArray&) = delete;
-    DeviceArray& operator=(const DeviceArray&) = delete;
-    DeviceArray(DeviceArray&& other) noexcept { swap(other); }
-    DeviceArray& operator=(DeviceArray&& other) noexcept {
-        swap(other);
-        return *this;
-    }
-    ~DeviceArray() { release(); }
-
-    void swap(DeviceArray& other) noexcept {
-        std::swap(ptr_, other.ptr_);
-        std::swap(size_, other.size_);
-        std::swap(capacity_, other.capacity_);
-    }
-    void resize(std::size_t n) {
-        if (n > capacity_) {
-            release();
-            const std::size_t bytes = n * sizeof(T);
-            cudaError_t status = cudaMalloc(reinterpret_cast<void**>(&ptr_), bytes);
-            if (status != cudaSuccess) {
-                (void)cudaGetLastError();
-                ptr_ = nullptr;
-                throw DeviceError("out of GPU memory allocating " + std::to_string(bytes) + " bytes (" +
-                                  std::to_string(memory_ledger().current.load()) + " bytes already held, " +
-                                  std::to_string(device_memory_free()) + " free)");
-            }
-            capacity_ = n;
-            memory_ledger().add(static_cast<std::int64_t>(bytes));
+// GPU global memory.
+struct CudaSpace {
+    static void* allocate(std::size_t bytes) {
+        void* p = nullptr;
+        if (cudaMalloc(&p, bytes) != cudaSuccess) {
+            (void)cudaGetLastError();
+            throw DeviceError("out of GPU memory allocating " + std::to_string(bytes) + " bytes (" +
+                              std::to_string(memory_ledger().current.load()) + " bytes already held, " +
+                              std::to_string(device_memory_free()) + " free)");
         }
-        size_ = n;
+        return p;
     }
-    void release() {
-        if (ptr_) {
-            memory_ledger().remove(static_cast<std::int64_t>(capacity_ * sizeof(T)));
-            cudaFree(ptr_);
-        }
-        ptr_ = nullptr;
-        size_ = capacity_ = 0;
+    static void release(void* p) { cudaFree(p); }
+    static void to_device(void* dst, const void* src, std::size_t bytes) {
+        check_cuda(cudaMemcpy(dst, src, bytes, cudaMemcpyHostToDevice), "copy to the GPU");
     }
-    std::size_t size() const { return size_; }
-    std::size_t bytes() const { return capacity_ * sizeof(T); }
-    bool empty() const { return size_ == 0; }
-    View<T> view() { return View<T>{ptr_, size_}; }
-    View<const T> view() const { return View<const T>{ptr_, size_}; }
-    View<const T> cview() const { return View<const T>{ptr_, size_}; }
-
-    void upload(const T* host, std::size_t n) {
-        resize(n);
-        if (n) check_cuda(cudaMemcpy(ptr_, host, n * sizeof(T), cudaMemcpyHostToDevice), "upload");
+    static void to_host(void* dst, const void* src, std::size_t bytes) {
+        check_cuda(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToHost), "copy from the GPU");
     }
-    void upload(const std::vector<T>& host) { upload(host.data(), host.size()); }
-    void download(T* host, std::size_t n) const {
-        const std::size_t count = n < size_ ? n : size_;
-        if (count) check_cuda(cudaMemcpy(host, ptr_, count * sizeof(T), cudaMemcpyDeviceToHost), "download");
+    static void within(void* dst, const void* src, std::size_t bytes) {
+        check_cuda(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToDevice), "copy on the GPU");
     }
-    void download(std::vector<T>& host) const {
-        host.resize(size_);
-        download(host.data(), size_);
-    }
-    std::vector<T> to_host() const {
-        std::vector<T> host;
-        download(host);
-        return host;
-    }
-    void download_range(T* host, std::size_t first, std::size_t n) const {
-        if (n)
-            check_cuda(cudaMemcpy(host, ptr_ + first, n * sizeof(T), cudaMemcpyDeviceToHost), "download_range");
-    }
-    // Copies n host values to elements [first, first + n) (a handful of values, not a stream).
-    void upload_range(const T* host, std::size_t first, std::size_t n) {
-        if (n)
-            check_cuda(cudaMemcpy(ptr_ + first, host, n * sizeof(T), cudaMemcpyHostToDevice), "upload_range");
-    }
-    void fill(const T& value);
-    void copy_from(const DeviceArray& other) {
-        resize(other.size_);
-        if (size_)
-            check_cuda(cudaMemcpy(ptr_, other.ptr_, size_ * sizeof(T), cudaMemcpyDeviceToDevice), "copy_from");
-    }
-
-   private:
-    T* ptr_ = nullptr;
-    std::size_t size_ = 0;
-    std::size_t capacity_ = 0;
+    template <class T>
+    static void fill(T* p, std::size_t n, T value);  // after parallel_for, below
+    static MemoryLedger& ledger() { return memory_ledger(); }
 };
+
+template <class T>
+using DeviceArray = BasicDeviceArray<T, CudaSpace>;
 
 template <class F>
 __global__ void parallel_for_kernel(std::size_t n, F f) {
@@ -174,10 +114,8 @@ void parallel_for(const char* name, std::size_t n, F f) {
 }
 
 template <class T>
-void DeviceArray<T>::fill(const T& value) {
-    T* p = ptr_;
-    const T v = value;
-    parallel_for("DeviceArray::fill", size_, [=] __device__(std::size_t i) { p[i] = v; });
+void CudaSpace::fill(T* p, std::size_t n, T value) {
+    parallel_for("DeviceArray::fill", n, [=] __device__(std::size_t i) { p[i] = value; });
 }
 
 // Applies f to an index; lets CUB read f(i) through a counting iterator.

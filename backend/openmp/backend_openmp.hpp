@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "backend/config.hpp"
+#include "backend/device_array.hpp"
 #include "backend/errors.hpp"
 #include "backend/memory_ledger.hpp"
 #include "backend/reduce_ops.hpp"
@@ -44,96 +45,28 @@ std::string device_description();     // e.g. "2 OpenMP threads on Intel Xeon ..
 std::int64_t device_memory_free();    // physical memory available, bytes
 inline void synchronize() {}
 
-// Owning array in backend memory. Contents are uninitialised after resize (callers fill what they
-// need); copies between host and backend are explicit.
-template <class T>
-class DeviceArray {
-   public:
-    DeviceArray() = default;
-    explicit DeviceArray(std::size_t n) { resize(n); }
-    DeviceArray(const DeviceArray&) = delete;
-    DeviceArray& operator=(const DeviceArray&) = delete;
-    DeviceArray(DeviceArray&& other) noexcept { swap(other); }
-    DeviceArray& operator=(DeviceArray&& other) noexcept {
-        swap(other);
-        return *this;
+// Host memory, 64-byte aligned.
+struct HostSpace {
+    static void* allocate(std::size_t bytes) {
+        void* p = std::aligned_alloc(64, ((bytes + 63) / 64) * 64);
+        if (!p) throw DeviceError("out of host memory allocating " + std::to_string(bytes) + " bytes");
+        return p;
     }
-    ~DeviceArray() { release(); }
-
-    void swap(DeviceArray& other) noexcept {
-        std::swap(ptr_, other.ptr_);
-        std::swap(size_, other.size_);
-        std::swap(capacity_, other.capacity_);
-    }
-    // Grows the allocation only when needed, so a per-step resize to the same size is free.
-    void resize(std::size_t n) {
-        if (n > capacity_) {
-            release();
-            const std::size_t bytes = ((n * sizeof(T) + 63) / 64) * 64;
-            ptr_ = static_cast<T*>(std::aligned_alloc(64, bytes));
-            if (!ptr_)
-                throw DeviceError("out of host memory allocating " + std::to_string(bytes) + " bytes");
-            capacity_ = n;
-            memory_ledger().add(static_cast<std::int64_t>(capacity_ * sizeof(T)));
-        }
-        size_ = n;
-    }
-    void release() {
-        if (ptr_) {
-            memory_ledger().remove(static_cast<std::int64_t>(capacity_ * sizeof(T)));
-            std::free(ptr_);
-        }
-        ptr_ = nullptr;
-        size_ = capacity_ = 0;
-    }
-    std::size_t size() const { return size_; }
-    std::size_t bytes() const { return capacity_ * sizeof(T); }
-    bool empty() const { return size_ == 0; }
-    View<T> view() { return View<T>{ptr_, size_}; }
-    View<const T> view() const { return View<const T>{ptr_, size_}; }
-    View<const T> cview() const { return View<const T>{ptr_, size_}; }
-
-    void upload(const T* host, std::size_t n) {
-        resize(n);
-        if (n) std::memcpy(ptr_, host, n * sizeof(T));
-    }
-    void upload(const std::vector<T>& host) { upload(host.data(), host.size()); }
-    void download(T* host, std::size_t n) const {
-        if (n) std::memcpy(host, ptr_, std::min(n, size_) * sizeof(T));
-    }
-    void download(std::vector<T>& host) const {
-        host.resize(size_);
-        download(host.data(), size_);
-    }
-    std::vector<T> to_host() const {
-        std::vector<T> host;
-        download(host);
-        return host;
-    }
-    // Copies part of the array to the host (used for a handful of counters per step).
-    void download_range(T* host, std::size_t first, std::size_t n) const {
-        if (n) std::memcpy(host, ptr_ + first, n * sizeof(T));
-    }
-    // Copies n host values to elements [first, first + n) (a handful of values, not a stream).
-    void upload_range(const T* host, std::size_t first, std::size_t n) {
-        if (n) std::memcpy(ptr_ + first, host, n * sizeof(T));
-    }
-    void fill(const T& value) {
-        T* p = ptr_;
-        const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(size_);
+    static void release(void* p) { std::free(p); }
+    static void to_device(void* dst, const void* src, std::size_t bytes) { std::memcpy(dst, src, bytes); }
+    static void to_host(void* dst, const void* src, std::size_t bytes) { std::memcpy(dst, src, bytes); }
+    static void within(void* dst, const void* src, std::size_t bytes) { std::memcpy(dst, src, bytes); }
+    template <class T>
+    static void fill(T* p, std::size_t n, T value) {
+        const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);
 #pragma omp parallel for schedule(static)
-        for (std::ptrdiff_t i = 0; i < n; ++i) p[i] = value;
+        for (std::ptrdiff_t i = 0; i < count; ++i) p[i] = value;
     }
-    void copy_from(const DeviceArray& other) {
-        resize(other.size_);
-        if (size_) std::memcpy(ptr_, other.ptr_, size_ * sizeof(T));
-    }
-
-   private:
-    T* ptr_ = nullptr;
-    std::size_t size_ = 0;
-    std::size_t capacity_ = 0;
+    static MemoryLedger& ledger() { return memory_ledger(); }
 };
+
+template <class T>
+using DeviceArray = BasicDeviceArray<T, HostSpace>;
 
 // f(i) for i in [0, n). `name` identifies the launch in errors and profiles.
 template <class F>
