@@ -16,7 +16,6 @@ build: setup
 demo: setup
 	@cmake --build $(BUILD_DIR) -j $(JOBS) --target meltwater
 	@$(BUILD_DIR)/meltwater run --out $(OUT)
-	@echo "demo: frames, stats.csv and summary.json are in $(abspath $(OUT))"
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
