@@ -295,29 +295,38 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     fluid_.mass = static_cast<Real>(fp.rest_density / sums.sum_W);
     delta_times_dt2_ = pcisph_delta(sums, fp.rest_density, fluid_.mass, 1.0);
 
-    boundary_volume_.resize(n);
-    if (store_.static_count())
-        compute_boundary_volumes(grid_.view(), store_.position.cview(), boundary_volume_.view(), moving,
-                                 store_.static_count(), false, fluid_.kernel);
-
-    use_lists_ = params_.neighbor_lists == SimulationParams::Lists::kAuto
-                     ? kPrefersNeighborLists
-                     : params_.neighbor_lists == SimulationParams::Lists::kOn;
     has_fluid_ = counts_.by_type[kFluid] > 0;  // a solids-only scene runs no fluid stage
+    use_lists_ = has_fluid_ && (params_.neighbor_lists == SimulationParams::Lists::kAuto
+                                    ? kPrefersNeighborLists
+                                    : params_.neighbor_lists == SimulationParams::Lists::kOn);
     has_viscosity_ = has_fluid_ && (fp.viscosity > 0 || (fp.wall_viscosity > 0 && store_.static_count() > 0));
-    active_stages_.push_back(kNeighbors);
-    has_solid_volumes_ = solids_.active() && counts_.by_type[kFluid] > 0;
-    if (has_solid_volumes_) active_stages_.push_back(kSolidVolumes);
-    if (has_viscosity_) {
-        active_stages_.push_back(kViscosity);
-        nonpressure_.resize(moving);
+    has_solid_volumes_ = solids_.active() && has_fluid_;
+
+    // Boundary volumes only matter to fluid: without fluid they are neither stored nor computed.
+    if (has_fluid_) {
+        boundary_volume_.resize(n);
+        if (store_.static_count())
+            compute_boundary_volumes(grid_.view(), store_.position.cview(), boundary_volume_.view(), moving,
+                                     store_.static_count(), false, fluid_.kernel);
+        pressure_acc_.resize(moving);
+        pressure_term_.resize(moving);
+        predicted_.resize(moving);
     }
+    if (has_viscosity_) nonpressure_.resize(moving);
+
+    active_stages_.push_back(kNeighbors);
+    if (has_solid_volumes_) active_stages_.push_back(kSolidVolumes);
+    if (has_viscosity_) active_stages_.push_back(kViscosity);
     if (has_fluid_) active_stages_.push_back(kPcisph);
     if (solids_.active()) active_stages_.push_back(kLsm);
     if (has_fluid_) active_stages_.push_back(kIntegrate);
-    pressure_acc_.resize(moving);
-    pressure_term_.resize(moving);
-    predicted_.resize(moving);
+
+    // One neighbour build now, so that every per-step buffer (sort keys, lists) is allocated
+    // before the first step and device_bytes() is the steady-state figure `info` reports.
+    ranges_ = grid_.build(store_);
+    if (solids_.active()) solids_.update_slot_map(store_);
+    if (use_lists_)
+        lists_.build(grid_.view(), ranges_.fluid_end, store_.position.cview(), Real(1.1) * fluid_.kernel.h);
 
     // The first CFL step uses the initial speeds.
     double max_speed2 = 0;

@@ -62,8 +62,6 @@ Result measure(const Options& o, const std::string& name, const SimulationSetup&
     r.total = sim->counts().total();
     r.steps = steps;
     r.stages = sim->stage_names();
-    r.bytes_per_fluid = double(sim->device_bytes()) / double(std::max(1L, r.fluid));
-    r.bytes_per_particle = double(sim->device_bytes()) / double(std::max(1L, r.total));
     std::vector<std::vector<double>> stage_ms(r.stages.size());
     std::vector<double> total_ms;
     double iterations = 0;
@@ -77,6 +75,9 @@ Result measure(const Options& o, const std::string& name, const SimulationSetup&
         r.error_avg += rep.density_error_avg;
         r.error_max = std::max(r.error_max, rep.density_error_max);
     }
+    // Memory after the run: every per-step buffer (sort keys, neighbour lists) has grown by now.
+    r.bytes_per_fluid = double(sim->device_bytes()) / double(std::max(1L, r.fluid));
+    r.bytes_per_particle = double(sim->device_bytes()) / double(std::max(1L, r.total));
     for (auto& v : stage_ms) r.stage_median_ms.push_back(median(v));
     r.total_median_ms = median(total_ms);
     r.iterations_avg = iterations / steps;
@@ -107,6 +108,11 @@ SimulationSetup dam_break(long target, CellOrdering ordering) {
     }
     s.velocity.assign(s.position.size(), Vec3{0, 0, 0});
     s.object.assign(s.position.size(), -1);
+    return s;
+}
+
+SimulationSetup with_lists(SimulationSetup s, bool lists) {
+    s.params.neighbor_lists = lists ? SimulationParams::Lists::kOn : SimulationParams::Lists::kOff;
     return s;
 }
 
@@ -191,11 +197,16 @@ int main(int argc, char** argv) {
                                    steps, 2));
         }
 
-        std::vector<Result> orderings;
+        std::vector<Result> variants;
         for (CellOrdering ordering : {CellOrdering::kLinear, CellOrdering::kZOrder})
-            orderings.push_back(measure(o, ordering == CellOrdering::kLinear ? "dam break 100k, linear cells"
-                                                                             : "dam break 100k, Z-order cells",
-                                        dam_break(100000, ordering), 10 * scale, 2));
+            variants.push_back(measure(o, ordering == CellOrdering::kLinear ? "dam break 100k, linear cells, lists"
+                                                                            : "dam break 100k, Z-order cells, lists",
+                                       with_lists(dam_break(100000, ordering), true), 10 * scale, 2));
+        // Gathering from the grid in every iteration: CUDA's default, and its memory layout.
+        for (long n : {100000L, 1000000L})
+            variants.push_back(measure(o, "dam break " + std::to_string(n / 1000) + "k, Z-order, grid gathers",
+                                       with_lists(dam_break(n, CellOrdering::kZOrder), false),
+                                       n >= 1000000 ? 3 * scale : 10 * scale, 2));
 
         std::ostringstream report;
         report << "Backend: " << o.backend << ", device: " << device << "\n\n"
@@ -206,8 +217,8 @@ int main(int argc, char** argv) {
                << "\nPeer (from the issue, SPlisHSPlasH PCISPH + Akinci, 2 threads on this kind of machine): 17-20 ms "
                   "per step at 0.05 m, 187 ms at 0.025 m; peak density 0.3-1% above rest.\n\n"
                << "### Dam breaks (0.6 x 0.8 x 0.8 m column, 1.6 x 1.0 x 0.8 m tank, dt = 0.0015 s x r0/0.02 m)\n\n"
-               << format_table(dams) << "\n### Cell ordering (same 100k dam break)\n\n"
-               << format_table(orderings);
+               << format_table(dams) << "\n### Variants: cell order, neighbour lists or grid gathers\n\n"
+               << format_table(variants);
         std::printf("%s", report.str().c_str());
         if (!o.out.empty()) {
             std::ofstream file(o.out, std::ios::app);
