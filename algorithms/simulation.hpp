@@ -30,6 +30,7 @@ struct SolverParams {
     Real cfl_number = 0.4;                   // Δt ≤ cfl · r0 / v_max in CFL mode
     Real dt_min = 1e-6;                      // CFL mode never goes below this
     Real eta = 0.01;                         // PCISPH stops when the average density error < η
+    Real eta_max = 0;                        // ... and, when positive, the largest one < eta_max
     int min_iterations = 3;
     int max_iterations = 100;
     // Start each step's pressure from this fraction of the previous step's instead of zero (an

@@ -132,7 +132,8 @@ class BackendSimulation final : public Simulation {
 
    private:
     // The PCISPH loop over a neighbourhood (the grid, or this step's lists): predict, density and
-    // pressure, error, pressure force; until the average error is below η (min/max iterations).
+    // pressure, error, pressure force; until the average error is below η, and the largest below
+    // eta_max when that is set (min/max iterations).
     template <class Neighbors>
     DensityError pcisph_iterations(const Neighbors& neighbors, std::size_t fluid_count, const Vec3* nonpressure,
                                    Real delta, Real dt, int& iterations) {
@@ -150,7 +151,8 @@ class BackendSimulation final : public Simulation {
                                   boundary_volume_.cview(), pressure_term_.cview(), pressure_acc_.view(), fluid_);
             ++iterations;
             const double average = fluid_count ? error.sum / double(fluid_count) : 0.0;
-            if (iterations >= solver.min_iterations && average <= solver.eta) break;
+            const bool peak_ok = solver.eta_max <= 0 || error.max <= solver.eta_max;
+            if (iterations >= solver.min_iterations && average <= solver.eta && peak_ok) break;
         }
         return error;
     }

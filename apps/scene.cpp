@@ -290,6 +290,7 @@ void read_solver(Section s, Scene& scene) {
     p.dt_mode = s.choice("dt_mode", "fixed", {"fixed", "cfl"}) == "cfl" ? TimeStepMode::kCfl : TimeStepMode::kFixed;
     p.cfl_number = Real(s.number("cfl_number", 0.4, Range{0, 1, true, false}));
     p.eta = Real(s.number("eta", 0.01, Range{0, 1, true, true}));
+    p.eta_max = Real(s.number("eta_max", 0.0, Range{0, 1, false, true}));
     p.min_iterations = s.integer("min_iterations", 3, 1, 1000);
     p.max_iterations = s.integer("max_iterations", 100, 1, 10000);
     p.warm_start = Real(s.number("warm_start", 0.0, Range{0, 1, false, true}));

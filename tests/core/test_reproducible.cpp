@@ -75,3 +75,25 @@ TEST_CASE("neighbour lists and grid gathers give the same dam break") {
     MESSAGE("largest position difference, lists against grid, after 50 steps: " << worst << " m");
     CHECK(worst == 0);  // the list keeps the grid's visiting order, so the sums are the same
 }
+
+TEST_CASE("solver.eta_max bounds the peak density error of every step") {
+    SimulationSetup setup = small_dam_break();
+    auto free_run = create_openmp_simulation(setup, 0);
+    setup.params.solver.eta_max = Real(0.005);
+    auto bounded_run = create_openmp_simulation(setup, 0);
+    long free_iterations = 0, bounded_iterations = 0;
+    double free_peak = 0;
+    for (int s = 0; s < 60; ++s) {
+        free_run->step();
+        bounded_run->step();
+        free_iterations += free_run->last_report().iterations;
+        free_peak = std::max(free_peak, free_run->last_report().density_error_max);
+        const StepReport& r = bounded_run->last_report();
+        bounded_iterations += r.iterations;
+        if (r.iterations < setup.params.solver.max_iterations) CHECK(r.density_error_max <= 0.005);
+    }
+    MESSAGE("peak error without eta_max " << 100 * free_peak << "%; iterations " << free_iterations << " without, "
+                                          << bounded_iterations << " with eta_max 0.5%");
+    CHECK(free_peak > 0.005);                         // the bound had something to do
+    CHECK(bounded_iterations > free_iterations);      // and it cost iterations
+}
