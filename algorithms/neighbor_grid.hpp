@@ -292,8 +292,7 @@ inline void NeighborGrid::build_static(ParticleStore& store) {
     store.permute(sorted_order_.cview(), first);
     static_begin_.resize(shape.cell_count);
     static_end_.resize(shape.cell_count);
-    static_begin_.fill(0);
-    static_end_.fill(0);
+    static_end_.fill(0);  // ends only, as in build()
     View<const std::uint8_t> type{store.type.view().data() + first, n};
     fill_cell_ranges(shape, position, type, false, n, first, static_begin_.view().data(), static_end_.view().data(),
                      nullptr);
@@ -324,7 +323,8 @@ inline GroupRanges NeighborGrid::build(ParticleStore& store) {
     sort_pairs("grid_sort", keys_.cview(), sorted_keys_.view(), order_.cview(), sorted_order_.view(),
                shape.key_bits());
     store.permute(sorted_order_.cview(), 0);
-    begin_.fill(0);
+    // Only the ends are cleared: an empty cell has end 0, so [begin, end) is empty whatever stale
+    // begin it holds, and every non-empty cell gets both written below.
     end_.fill(0);
     group_first_.resize(kGroupCount);
     group_first_.fill(static_cast<std::uint32_t>(n));

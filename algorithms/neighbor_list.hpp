@@ -45,16 +45,15 @@ inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, V
     counts_.resize(fluid_count);
     boundary_begin_.resize(fluid_count);
     offsets_.resize(fluid_count + 1);
-    View<std::uint32_t> counts = counts_.view(), boundary_begin = boundary_begin_.view();
+    View<std::uint32_t> counts = counts_.view(), boundary_begin = boundary_begin_.view();  // begin: fill pass
     parallel_for("neighbor_list_count", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i];
-        std::uint32_t fluid = 0, boundary = 0;
-        grid.for_each_fluid(xi, [&](std::uint32_t j) { fluid += norm2(xi - position[j]) < r2; });
-        auto count_boundary = [&](std::uint32_t b) { boundary += norm2(xi - position[b]) < r2; };
-        grid.for_each_static(xi, count_boundary);
-        grid.for_each_solid(xi, count_boundary);
-        counts[i] = fluid + boundary;
-        boundary_begin[i] = fluid;  // a count for now; made an index by the fill pass
+        std::uint32_t count = 0;
+        auto within = [&](std::uint32_t j) { count += norm2(xi - position[j]) < r2; };
+        grid.for_each_fluid(xi, within);
+        grid.for_each_static(xi, within);
+        grid.for_each_solid(xi, within);
+        counts[i] = count;
     });
     // One small host copy: the total sizes the index array (which only ever grows).
     entries_ = exclusive_scan("neighbor_list_offsets", counts_.cview(), View<std::uint32_t>{offsets_.view().data(), fluid_count});

@@ -43,7 +43,7 @@ class ParticleStore {
           type(add<std::uint8_t>("type", FieldLife::kPersistent)),
           object(add<std::int32_t>("object", FieldLife::kPersistent)),
           density(add<Real>("density", FieldLife::kPersistent)),
-          pressure(add<Real>("pressure", FieldLife::kPersistent)) {}
+          pressure(add<Real>("pressure", FieldLife::kScratch)) {}
 
     ParticleStore(const ParticleStore&) = delete;
     ParticleStore& operator=(const ParticleStore&) = delete;
@@ -87,7 +87,7 @@ class ParticleStore {
     DeviceArray<std::uint8_t>& type;
     DeviceArray<std::int32_t>& object;
     DeviceArray<Real>& density;   // persistent: the last predicted density seeds viscosity
-    DeviceArray<Real>& pressure;  // persistent: warm-starts the next step's PCISPH
+    DeviceArray<Real>& pressure;  // recomputed from zero every step
 
    private:
     struct Field {

@@ -98,10 +98,12 @@ inline void predict_positions(std::size_t fluid_count, View<const Vec3> position
 
 // Predicted density from fluid (at predicted positions) and boundary particles, then
 // p_i += δ (ρ*_i - ρ0), clamped at 0 (free-surface particle deficiency), and p_i/ρ_i².
+// The first iteration of a step starts from p = 0 (so no separate pass clears the pressure).
 template <class Neighbors>
 void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
                                   View<const Vec3> position, View<const Real> boundary_volume, View<Real> density,
-                                  View<Real> pressure, View<Real> pressure_term, FluidConstants c, Real delta) {
+                                  View<Real> pressure, View<Real> pressure_term, FluidConstants c, Real delta,
+                                  bool first_iteration) {
     parallel_for("pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         Real fluid_sum = 0, boundary_sum = 0;
@@ -115,7 +117,7 @@ void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, 
         });
         const Real rho = c.mass * fluid_sum + c.rest_density * boundary_sum;
         density[i] = rho;
-        const Real p_raw = pressure[i] + delta * (rho - c.rest_density);
+        const Real p_raw = (first_iteration ? Real(0) : pressure[i]) + delta * (rho - c.rest_density);
         const Real p = p_raw > Real(0) ? p_raw : Real(0);
         pressure[i] = p;
         pressure_term[i] = p / (rho * rho);  // p/ρ², read by every neighbour's pressure force
@@ -153,14 +155,6 @@ void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<co
             if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.grad_W_r2(d, r2);
         });
         pressure_acc[i] = -(c.mass * fluid_sum + (c.rest_density * pi_rho2) * boundary_sum);
-    });
-}
-
-// p/ρ² from stored pressure and density (for a warm start, before the first density pass).
-inline void pressure_term_from_pressure(std::size_t fluid_count, View<const Real> density, View<const Real> pressure,
-                                        View<Real> pressure_term) {
-    parallel_for("pcisph_pressure_term", fluid_count, [=] MW_HD(std::size_t i) {
-        pressure_term[i] = pressure[i] / (density[i] * density[i]);
     });
 }
 

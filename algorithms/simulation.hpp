@@ -33,10 +33,6 @@ struct SolverParams {
     Real eta_max = 0;                        // ... and, when positive, the largest one < eta_max
     int min_iterations = 3;
     int max_iterations = 100;
-    // Start each step's pressure from this fraction of the previous step's instead of zero (an
-    // addition to the original PCISPH; 0 is the original). The previous pressure also holds the
-    // one-off correction of its own step, so re-applying all of it overshoots.
-    Real warm_start = 0;
 };
 
 struct SimulationParams {

@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/array_ops.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/neighbor_list.hpp"
 #include "algorithms/particle_store.hpp"
@@ -25,7 +24,6 @@ class BackendSimulation final : public Simulation {
     explicit BackendSimulation(const SimulationSetup& setup);
 
     void step() override {
-        const SolverParams& solver = params_.solver;
         const Real dt = choose_time_step();
 
         // 1. Neighbour search: sort moving particles by cell, permute every field, cell ranges.
@@ -66,20 +64,6 @@ class BackendSimulation final : public Simulation {
         if (has_fluid_) {
             timers_.start(kPcisph);
             const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
-            if (solver.warm_start > 0) {
-                scale_prefix(store_.pressure.view(), fluid_count, solver.warm_start);
-                // Start from last step's pressure (persistent, permuted with the particles): in a
-                // settled fluid the iterations then only correct what changed.
-                predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure, nullptr,
-                                  predicted_.view(), fluid_.gravity, dt);
-                pressure_term_from_pressure(fluid_count, store_.density.cview(), store_.pressure.cview(),
-                                            pressure_term_.view());
-                pressure_acceleration(grid, fluid_count, predicted_.cview(), store_.position.cview(),
-                                      boundary_volume_.cview(), pressure_term_.cview(), pressure_acc_.view(), fluid_);
-            } else {
-                fill_prefix(store_.pressure.view(), fluid_count, Real(0));
-                fill_prefix(pressure_acc_.view(), fluid_count, Vec3{0, 0, 0});
-            }
             error = use_lists_ ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, iterations)
                                : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, iterations);
             timers_.stop(kPcisph);
@@ -141,11 +125,13 @@ class BackendSimulation final : public Simulation {
         DensityError error;
         iterations = 0;
         while (iterations < solver.max_iterations) {
+            // The first prediction has no pressure acceleration yet (nothing to clear beforehand).
+            const bool first = iterations == 0;
             predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
-                              pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt);
+                              first ? nullptr : pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt);
             predict_density_and_pressure(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
                                          boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
-                                         pressure_term_.view(), fluid_, delta);
+                                         pressure_term_.view(), fluid_, delta, first);
             error = density_error(fluid_count, store_.density.cview(), fluid_.rest_density);
             pressure_acceleration(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
                                   boundary_volume_.cview(), pressure_term_.cview(), pressure_acc_.view(), fluid_);

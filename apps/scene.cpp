@@ -293,7 +293,6 @@ void read_solver(Section s, Scene& scene) {
     p.eta_max = Real(s.number("eta_max", 0.0, Range{0, 1, false, true}));
     p.min_iterations = s.integer("min_iterations", 3, 1, 1000);
     p.max_iterations = s.integer("max_iterations", 100, 1, 10000);
-    p.warm_start = Real(s.number("warm_start", 0.0, Range{0, 1, false, true}));
     if (p.max_iterations < p.min_iterations)
         s.fail(s.key_path("max_iterations"), "must be >= min_iterations (" + std::to_string(p.min_iterations) +
                                                  "), got " + std::to_string(p.max_iterations));

@@ -170,6 +170,7 @@ int main(int argc, char** argv) {
     }
     try {
         const std::string device =
+            // A tiny simulation applies --threads before the OpenMP device (thread count) is named.
             o.backend == "cuda" ? cuda_backend_info().description : make(o, dam_break(1000, CellOrdering::kZOrder))->device_name();
         std::fprintf(stderr, "bench_fluid on %s (%s)\n", o.backend.c_str(), device.c_str());
         const int scale = o.quick ? 1 : 3;

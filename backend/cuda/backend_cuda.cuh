@@ -184,17 +184,6 @@ MW_INLINE void atomic_add(float* address, float value) {
 MW_INLINE void atomic_add(double* address, double value) {
     MW_DEVICE_OR_HOST(atomicAdd(address, value), (void)(*address += value));
 }
-MW_INLINE int atomic_max(int* address, int value) {
-#if defined(__CUDA_ARCH__)
-    return atomicMax(address, value);
-#else
-    int seen = __atomic_load_n(address, __ATOMIC_RELAXED);
-    while (seen < value &&
-           !__atomic_compare_exchange_n(address, &seen, value, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-    }
-    return seen;
-#endif
-}
 
 // Stage timers on CUDA events: no synchronisation until read(), once per step.
 class StageTimers {

@@ -163,13 +163,6 @@ MW_INLINE void atomic_add(double* address, double value) {
 #pragma omp atomic
     *address += value;
 }
-MW_INLINE int atomic_max(int* address, int value) {
-    int seen = __atomic_load_n(address, __ATOMIC_RELAXED);
-    while (seen < value &&
-           !__atomic_compare_exchange_n(address, &seen, value, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-    }
-    return seen;
-}
 
 // Per-stage wall-clock timers. A stage is started and stopped at most once per step; read()
 // returns each stage's milliseconds for the step and clears them.

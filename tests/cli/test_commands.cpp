@@ -60,7 +60,6 @@ TEST_CASE("bad input: scene keys and values") {
     // Solver and neighbour switches.
     check_rejected(run("info " + tiny() + " --set fluid.wall_viscosity=-1"), {"fluid.wall_viscosity"});
     check_rejected(run("info " + tiny() + " --set solver.eta_max=1.5"), {"solver.eta_max"});
-    check_rejected(run("info " + tiny() + " --set solver.warm_start=1"), {"solver.warm_start"});
     check_rejected(run("info " + tiny() + " --set neighbors.cells_per_support=3"), {"neighbors.cells_per_support"});
     check_rejected(run("info " + tiny() + " --set neighbors.lists=maybe"), {"neighbors.lists", "maybe"});
 }

@@ -5,7 +5,6 @@
 #include <numeric>
 #include <random>
 
-#define MW_BACKEND_OPENMP
 #include "backend/backend.hpp"
 
 using namespace mw;

@@ -68,7 +68,6 @@ TEST_CASE("neighbour lists and grid gathers give the same dam break") {
     const HostParticles with_lists = run(create_openmp_simulation(setup, 0), 50);
     setup.params.neighbor_lists = SimulationParams::Lists::kOff;
     const HostParticles with_grid = run(create_openmp_simulation(setup, 0), 50);
-    const double domain_size = norm(setup.params.domain_max - setup.params.domain_min);
     double worst = 0;
     for (std::size_t i = 0; i < with_lists.position.size(); ++i)
         worst = std::max(worst, double(norm(with_lists.position[i] - with_grid.position[i])));

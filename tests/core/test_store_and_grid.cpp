@@ -7,7 +7,6 @@
 #include <random>
 #include <set>
 
-#define MW_BACKEND_OPENMP
 #include "algorithms/neighbor_grid.hpp"
 
 using namespace mw;
