@@ -1,10 +1,13 @@
 // Per-step neighbour lists for fluid particles (CSR): every fluid and boundary particle within
-// h + skin of fluid particle i at the start of the step, fluid neighbours first. Built once per
+// h of fluid particle i at the start of the step, fluid neighbours first. Built once per
 // step from the grid (count, scan, fill: exact, no cap), then read by every PCISPH iteration,
 // so the 27-cell candidate search runs twice per step instead of twice per iteration.
 //
-// The grid (GridView) and the list (NeighborListView) offer the same gather interface,
-// gather_fluid(i, x, f) and gather_boundary(i, x, f), so the solver is written once for both.
+// The grid (GridView) and the list (NeighborListView) offer the same gather interface: sums of
+// f(j) over i's fluid or boundary neighbours (sum_fluid, sum_boundary, and the 3-vector forms
+// sum_fluid3, sum_boundary3), so the solver is written once for both. f must give 0 by itself for
+// a j out of range, without a branch: a branch-free term (selects) measured 2x faster than a
+// tested one in the PCISPH gathers (docs/solver.md).
 #pragma once
 #include "algorithms/neighbor_grid.hpp"
 
@@ -16,12 +19,34 @@ struct NeighborListView {
     const std::uint32_t* indices = nullptr;
 
     template <class F>
-    MW_INLINE void gather_fluid(std::size_t i, Vec3, F&& f) const {
-        for (std::uint32_t k = offsets[i], e = boundary_begin[i]; k < e; ++k) f(indices[k]);
+    MW_INLINE Real sum_fluid(std::size_t i, Vec3, F&& f) const {
+        return sum(offsets[i], boundary_begin[i], f);
     }
     template <class F>
-    MW_INLINE void gather_boundary(std::size_t i, Vec3, F&& f) const {
-        for (std::uint32_t k = boundary_begin[i], e = offsets[i + 1]; k < e; ++k) f(indices[k]);
+    MW_INLINE Real sum_boundary(std::size_t i, Vec3, F&& f) const {
+        return sum(boundary_begin[i], offsets[i + 1], f);
+    }
+    template <class F>
+    MW_INLINE Vec3 sum_fluid3(std::size_t i, Vec3, F&& f) const {
+        return sum3(offsets[i], boundary_begin[i], f);
+    }
+    template <class F>
+    MW_INLINE Vec3 sum_boundary3(std::size_t i, Vec3, F&& f) const {
+        return sum3(boundary_begin[i], offsets[i + 1], f);
+    }
+
+   private:
+    template <class F>
+    MW_INLINE Real sum(std::uint32_t begin, std::uint32_t end, F& f) const {
+        Real total = 0;
+        for (std::uint32_t k = begin; k < end; ++k) total += f(indices[k]);
+        return total;
+    }
+    template <class F>
+    MW_INLINE Vec3 sum3(std::uint32_t begin, std::uint32_t end, F& f) const {
+        Vec3 total{0, 0, 0};
+        for (std::uint32_t k = begin; k < end; ++k) total += f(indices[k]);
+        return total;
     }
 };
 
@@ -62,18 +87,24 @@ inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, V
     indices_.resize(entries_ > 0 ? entries_ : 1);
     View<const std::uint32_t> offsets = offsets_.cview();
     std::uint32_t* indices = indices_.view().data();
+    // Branch-free fill (whether a candidate is in range is unpredictable, and a mispredicted
+    // store cost 3x the count pass): every candidate is written, the cursor advances only for
+    // those in range. Once i's row is full, writes go to a local dummy so that they never touch
+    // the next particle's row, which another thread may be filling.
     parallel_for("neighbor_list_fill", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i];
+        const std::uint32_t row_end = offsets[i + 1];
         std::uint32_t k = offsets[i];
-        grid.for_each_fluid(xi, [&](std::uint32_t j) {
-            if (norm2(xi - position[j]) < r2) indices[k++] = j;
-        });
-        boundary_begin[i] = k;
-        auto add_boundary = [&](std::uint32_t b) {
-            if (norm2(xi - position[b]) < r2) indices[k++] = b;
+        std::uint32_t overflow = 0;
+        auto add = [&](std::uint32_t j) {
+            std::uint32_t* slot = k < row_end ? indices + k : &overflow;
+            *slot = j;
+            k += norm2(xi - position[j]) < r2;
         };
-        grid.for_each_static(xi, add_boundary);
-        grid.for_each_solid(xi, add_boundary);
+        grid.for_each_fluid(xi, add);
+        boundary_begin[i] = k;
+        grid.for_each_static(xi, add);
+        grid.for_each_solid(xi, add);
     });
 }
 

@@ -106,14 +106,11 @@ void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, 
                                   bool first_iteration) {
     parallel_for("pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
-        Real fluid_sum = 0, boundary_sum = 0;
-        neighbors.gather_fluid(i, position[i], [&](std::uint32_t j) {
-            const Real r2 = norm2(xi - predicted[j]);
-            if (r2 < c.support2) fluid_sum += c.kernel.W(std::sqrt(r2));
+        const Real fluid_sum = neighbors.sum_fluid(i, position[i], [&](std::uint32_t j) {
+            return c.kernel.W_r2(norm2(xi - predicted[j]));
         });
-        neighbors.gather_boundary(i, position[i], [&](std::uint32_t b) {
-            const Real r2 = norm2(xi - position[b]);
-            if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.W(std::sqrt(r2));
+        const Real boundary_sum = neighbors.sum_boundary(i, position[i], [&](std::uint32_t b) {
+            return boundary_volume[b] * c.kernel.W_r2(norm2(xi - position[b]));
         });
         const Real rho = c.mass * fluid_sum + c.rest_density * boundary_sum;
         density[i] = rho;
@@ -142,17 +139,14 @@ void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<co
     parallel_for("pcisph_pressure_force", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         const Real pi_rho2 = pressure_term[i];
-        Vec3 fluid_sum{0, 0, 0}, boundary_sum{0, 0, 0};
-        neighbors.gather_fluid(i, position[i], [&](std::uint32_t j) {
+        // Out-of-range pairs and i itself contribute a zero gradient, so no test is needed.
+        const Vec3 fluid_sum = neighbors.sum_fluid3(i, position[i], [&](std::uint32_t j) {
             const Vec3 d = xi - predicted[j];
-            const Real r2 = norm2(d);
-            if (r2 >= c.support2 || j == i) return;
-            fluid_sum += (pi_rho2 + pressure_term[j]) * c.kernel.grad_W_r2(d, r2);
+            return (pi_rho2 + pressure_term[j]) * c.kernel.grad_W_r2_select(d, norm2(d));
         });
-        neighbors.gather_boundary(i, position[i], [&](std::uint32_t b) {
+        const Vec3 boundary_sum = neighbors.sum_boundary3(i, position[i], [&](std::uint32_t b) {
             const Vec3 d = xi - position[b];
-            const Real r2 = norm2(d);
-            if (r2 < c.support2) boundary_sum += boundary_volume[b] * c.kernel.grad_W_r2(d, r2);
+            return boundary_volume[b] * c.kernel.grad_W_r2_select(d, norm2(d));
         });
         pressure_acc[i] = -(c.mass * fluid_sum + (c.rest_density * pi_rho2) * boundary_sum);
     });

@@ -55,6 +55,27 @@ struct CubicSpline3D {
         const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
         return (grad_scale * (Real(4) * b * b - a * a) * inv_r) * r_vec;
     }
+    // W from |r_vec|², without branches (selects only), so that neighbour sums vectorise: 0 for
+    // r ≥ h.
+    MW_INLINE Real W_r2(Real r2) const {
+        const Real q = std::sqrt(r2) * inv_h;
+        const Real a = Real(1) - q > Real(0) ? Real(1) - q : Real(0);
+        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
+        return sigma * (Real(2) * a * a * a - Real(8) * b * b * b);
+    }
+    // ∇W from r_vec and |r_vec|², without branches: 0 for r ≥ h and for r = 0 (a particle and
+    // itself).
+    MW_INLINE Vec3 grad_W_r2_select(Vec3 r_vec, Real r2) const {
+        // The division is not conditional (a conditional one could trap, which stops the compiler
+        // from turning it into a select): r = 0 divides by 1 and is masked after.
+        const bool apart = r2 > Real(1e-18) * h * h;
+        const Real r = std::sqrt(r2);
+        const Real inv_r = apart ? Real(1) / (apart ? r : Real(1)) : Real(0);
+        const Real q = r * inv_h;
+        const Real a = Real(1) - q > Real(0) ? Real(1) - q : Real(0);
+        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
+        return (grad_scale * (Real(4) * b * b - a * a) * inv_r) * r_vec;
+    }
     // Laplacian of the viscosity kernel; never negative, so viscosity never injects energy.
     MW_INLINE Real laplacian_visc(Real r) const { return r < h ? visc_scale * (h - r) : Real(0); }
 };

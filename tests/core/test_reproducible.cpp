@@ -62,6 +62,9 @@ TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break") {
     CHECK(worst < 1e-4 * domain_size);
 }
 
+// Lists hold the pairs within h at the start of a step; grid gathers also see pairs that come
+// within h while PCISPH predicts (weights of order (Δt |v_ij| / h)³), so the two differ by rounding-
+// sized amounts that grow slowly, not bitwise.
 TEST_CASE("neighbour lists and grid gathers give the same dam break") {
     SimulationSetup setup = small_dam_break();
     setup.params.neighbor_lists = SimulationParams::Lists::kOn;
@@ -72,7 +75,7 @@ TEST_CASE("neighbour lists and grid gathers give the same dam break") {
     for (std::size_t i = 0; i < with_lists.position.size(); ++i)
         worst = std::max(worst, double(norm(with_lists.position[i] - with_grid.position[i])));
     MESSAGE("largest position difference, lists against grid, after 50 steps: " << worst << " m");
-    CHECK(worst == 0);  // the list keeps the grid's visiting order, so the sums are the same
+    CHECK(worst < 1e-3 * setup.params.fluid.spacing);
 }
 
 TEST_CASE("solver.eta_max bounds the peak density error of every step") {

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "algorithms/neighbor_grid.hpp"
+#include "algorithms/neighbor_list.hpp"
 
 using namespace mw;
 
@@ -94,7 +95,8 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> nanoflann_pairs(const std::vec
 }
 
 std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<Vec3>& points, Vec3 lo, Vec3 hi, Real h,
-                                                            CellOrdering ordering, int cells_per_h) {
+                                                            CellOrdering ordering, int cells_per_h,
+                                                            bool with_lists = false) {
     ParticleStore store;
     const std::size_t n = points.size();
     store.resize(n, n);
@@ -111,15 +113,27 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<V
     const auto sorted_id = store.id.to_host();
     const auto sorted_pos = store.position.to_host();
     std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
-    for (std::size_t i = 0; i < n; ++i)
-        view.for_each_fluid(sorted_pos[i], [&](std::uint32_t j) {
-            if (j != i && norm2(sorted_pos[i] - sorted_pos[j]) < h * h) pairs.insert({sorted_id[i], sorted_id[j]});
-        });
+    if (!with_lists) {
+        for (std::size_t i = 0; i < n; ++i)
+            view.for_each_fluid(sorted_pos[i], [&](std::uint32_t j) {
+                if (j != i && norm2(sorted_pos[i] - sorted_pos[j]) < h * h) pairs.insert({sorted_id[i], sorted_id[j]});
+            });
+        return pairs;
+    }
+    // The CSR lists the PCISPH gathers read on CPU cores (branch-free fill), radius h.
+    NeighborList lists;
+    lists.build(view, n, store.position.cview(), h);
+    const NeighborListView rows = lists.view();
+    for (std::size_t i = 0; i < n; ++i) {
+        CHECK(rows.boundary_begin[i] == rows.offsets[i + 1]);  // no boundary particles here
+        for (std::uint32_t k = rows.offsets[i]; k < rows.offsets[i + 1]; ++k)
+            if (rows.indices[k] != i) pairs.insert({sorted_id[i], sorted_id[rows.indices[k]]});
+    }
     return pairs;
 }
 }  // namespace
 
-TEST_CASE("grid neighbours equal nanoflann's radius search") {
+TEST_CASE("grid neighbours and neighbour lists equal nanoflann's radius search") {
     std::mt19937 rng(11);
     std::uniform_real_distribution<Real> unit(0, 1);
     const Vec3 lo{0, 0, 0}, hi{Real(1.0), Real(0.6), Real(0.4)};
@@ -147,6 +161,7 @@ TEST_CASE("grid neighbours equal nanoflann's radius search") {
         CAPTURE(cells_per_h);
         CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kLinear, cells_per_h) == expected);
         CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kZOrder, cells_per_h) == expected);
+        CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kZOrder, cells_per_h, true) == expected);
     }
 }
 
