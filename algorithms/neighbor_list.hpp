@@ -84,7 +84,9 @@ inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, V
     entries_ = exclusive_scan("neighbor_list_offsets", counts_.cview(), View<std::uint32_t>{offsets_.view().data(), fluid_count});
     const std::uint32_t total = static_cast<std::uint32_t>(entries_);
     offsets_.upload_range(&total, fluid_count, 1);
-    indices_.resize(entries_ > 0 ? entries_ : 1);
+    // Lists grow as a flow spreads along walls or compresses; a quarter of headroom keeps the
+    // reallocation (and its first-touch page faults) out of almost every step.
+    if (entries_ > indices_.capacity()) indices_.resize(entries_ + entries_ / 4 + 1);
     View<const std::uint32_t> offsets = offsets_.cview();
     std::uint32_t* indices = indices_.view().data();
     // Branch-free fill (whether a candidate is in range is unpredictable, and a mispredicted

@@ -60,6 +60,7 @@ class BasicDeviceArray {
         size_ = capacity_ = 0;
     }
     std::size_t size() const { return size_; }
+    std::size_t capacity() const { return capacity_; }
     std::size_t bytes() const { return capacity_ * sizeof(T); }
     bool empty() const { return size_ == 0; }
     View<T> view() { return View<T>{ptr_, size_}; }
