@@ -45,18 +45,10 @@ struct CubicSpline3D {
         const Real dwdq = Real(4) * b * b - a * a;  // (dW/dq) / (6σ)
         return (grad_scale * dwdq / r) * r_vec;
     }
-    // The same from |r_vec|² alone, with one reciprocal square root and no division (hot loops).
-    MW_INLINE Vec3 grad_W_r2(Vec3 r_vec, Real r2) const {
-        if (r2 <= Real(1e-18) * h * h) return Vec3{0, 0, 0};
-        const Real inv_r = Real(1) / std::sqrt(r2);
-        const Real q = r2 * inv_r * inv_h;
-        if (q >= Real(1)) return Vec3{0, 0, 0};
-        const Real a = Real(1) - q;
-        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
-        return (grad_scale * (Real(4) * b * b - a * a) * inv_r) * r_vec;
-    }
-    // W from |r_vec|², without branches (selects only), so that neighbour sums vectorise: 0 for
-    // r ≥ h.
+    // The forms the neighbour sums use: from |r_vec|², with selects and no branches, and 0 by
+    // themselves out of range, so a sum needs no test per neighbour (whether a neighbour is in
+    // range is unpredictable; the branch-free sums measured twice as fast, docs/solver.md).
+    // W for r ≥ h is 0.
     MW_INLINE Real W_r2(Real r2) const {
         const Real q = std::sqrt(r2) * inv_h;
         const Real a = Real(1) - q > Real(0) ? Real(1) - q : Real(0);
@@ -65,7 +57,7 @@ struct CubicSpline3D {
     }
     // ∇W from r_vec and |r_vec|², without branches: 0 for r ≥ h and for r = 0 (a particle and
     // itself).
-    MW_INLINE Vec3 grad_W_r2_select(Vec3 r_vec, Real r2) const {
+    MW_INLINE Vec3 grad_W_r2(Vec3 r_vec, Real r2) const {
         // The division is not conditional (a conditional one could trap, which stops the compiler
         // from turning it into a select): r = 0 divides by 1 and is masked after.
         const bool apart = r2 > Real(1e-18) * h * h;

@@ -1,6 +1,9 @@
 // Kernel normalisation, gradient antisymmetry, and PCISPH's δ against METHOD.md's check values.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "algorithms/pcisph_delta.hpp"
 #include "algorithms/sph_kernels.hpp"
 
@@ -42,6 +45,31 @@ TEST_CASE("kernel gradient is antisymmetric, points inward and matches finite di
     }
     CHECK(norm(kernel.grad_W(Vec3{0, 0, 0}, 0)) == 0);
     CHECK(kernel.W(Real(0.1)) == 0);
+}
+
+TEST_CASE("the branch-free forms the neighbour sums use equal W and grad W, and vanish out of range") {
+    const Real h = Real(0.1);
+    const CubicSpline3D kernel = CubicSpline3D::with_support(h);
+    double worst_w = 0, worst_grad = 0;
+    for (int k = 1; k <= 400; ++k) {
+        // Directions vary with k; distances run from near 0 to 1.2 h, across q = 1/2 and q = 1.
+        const Real d = h * Real(k) / Real(333);
+        const Vec3 raw{std::cos(Real(k)), std::sin(Real(0.7) * Real(k)), Real(0.3)};
+        const Vec3 dir = raw / norm(raw);
+        const Vec3 r = d * dir;
+        const Real r2 = norm2(r);
+        worst_w = std::max(worst_w, double(std::fabs(kernel.W_r2(r2) - kernel.W(d))) / double(kernel.W(0)));
+        worst_grad = std::max(worst_grad, double(norm(kernel.grad_W_r2(r, r2) - kernel.grad_W(r, d))) /
+                                              double(kernel.grad_scale));
+        if (d >= h) {
+            CHECK(kernel.W_r2(r2) == 0);
+            CHECK(norm(kernel.grad_W_r2(r, r2)) == 0);
+        }
+    }
+    CHECK(worst_w < 1e-5);
+    CHECK(worst_grad < 1e-5);
+    CHECK(kernel.W_r2(0) == doctest::Approx(double(kernel.W(0))));
+    CHECK(norm(kernel.grad_W_r2(Vec3{0, 0, 0}, 0)) == 0);  // a particle and itself: no force
 }
 
 TEST_CASE("PCISPH delta matches the check values of METHOD.md") {
