@@ -1,7 +1,12 @@
-// Per-step neighbour lists for fluid particles (CSR): every fluid and boundary particle within
-// h of fluid particle i at the start of the step, fluid neighbours first. Built once per
-// step from the grid (count, scan, fill: exact, no cap), then read by every PCISPH iteration,
-// so the 27-cell candidate search runs twice per step instead of twice per iteration.
+// Per-step neighbour lists for fluid particles (CSR with slack): every fluid and boundary particle
+// within h of fluid particle i at the start of the step, fluid neighbours first. Built once per
+// step from the grid, then read by every PCISPH iteration.
+//
+// One candidate search per step, not two: each row gets room for the particle's count of the
+// last step (a persistent store field, so it travels with the particle through the sort) plus
+// kRowSlack; one fill pass writes the rows and records the exact counts. If any row overflowed
+// (rare: a count grew by more than the slack in one step), the rows are laid out again from the
+// exact counts and filled a second time. Exact either way: no cap, nothing dropped.
 //
 // The grid (GridView) and the list (NeighborListView) offer the same gather interface: sums of
 // f(j) over i's fluid or boundary neighbours (sum_fluid, sum_boundary, and the 3-vector forms
@@ -14,8 +19,9 @@
 MW_BACKEND_BEGIN
 
 struct NeighborListView {
-    const std::uint32_t* offsets = nullptr;         // [fluid_count + 1]
+    const std::uint32_t* offsets = nullptr;         // [fluid_count + 1]: first slot of each row
     const std::uint32_t* boundary_begin = nullptr;  // [fluid_count]: first boundary entry of i
+    const std::uint32_t* row_end = nullptr;         // [fluid_count]: one past i's last entry
     const std::uint32_t* indices = nullptr;
 
     template <class F>
@@ -24,7 +30,7 @@ struct NeighborListView {
     }
     template <class F>
     MW_INLINE Real sum_boundary(std::size_t i, Vec3, F&& f) const {
-        return sum(boundary_begin[i], offsets[i + 1], f);
+        return sum(boundary_begin[i], row_end[i], f);
     }
     template <class F>
     MW_INLINE Vec3 sum_fluid3(std::size_t i, Vec3, F&& f) const {
@@ -32,7 +38,7 @@ struct NeighborListView {
     }
     template <class F>
     MW_INLINE Vec3 sum_boundary3(std::size_t i, Vec3, F&& f) const {
-        return sum3(boundary_begin[i], offsets[i + 1], f);
+        return sum3(boundary_begin[i], row_end[i], f);
     }
 
    private:
@@ -52,54 +58,75 @@ struct NeighborListView {
 
 class NeighborList {
    public:
+    // Room per row beyond the last step's count: 64 bytes per fluid particle. A particle moving
+    // toward a wall sampled at r0/2 gains many boundary neighbours in one step. Steps that needed
+    // a second fill (measured): slack 4: 643 of 1000 (6,859-particle block), 152 of 250 (59,319),
+    // 1169 of 1209 (default dam break, CFL steps); slack 8: 3, 4, 439; slack 16: 1, 1, 27.
+    static constexpr std::uint32_t kRowSlack = 16;
+
     // Lists for fluid particles [0, fluid_count) within `radius` of their current positions.
-    inline void build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius);
+    // row_counts[i] is i's count from the last build (0 before the first) and receives the new one.
+    inline void build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
+                      View<std::uint32_t> row_counts);
     NeighborListView view() const {
-        return NeighborListView{offsets_.view().data(), boundary_begin_.view().data(), indices_.view().data()};
+        return NeighborListView{offsets_.view().data(), boundary_begin_.view().data(), row_end_.view().data(),
+                                indices_.view().data()};
     }
-    std::size_t bytes() const { return counts_.bytes() + offsets_.bytes() + boundary_begin_.bytes() + indices_.bytes(); }
-    std::size_t entries() const { return entries_; }
+    std::size_t bytes() const {
+        return capacity_.bytes() + offsets_.bytes() + boundary_begin_.bytes() + row_end_.bytes() + indices_.bytes();
+    }
+    std::size_t slots() const { return slots_; }
+    long second_fills() const { return second_fills_; }  // builds that needed a second fill
+
+    // The two steps of build(). Public only because nvcc allows no device lambda inside a
+    // private member function.
+    // Rows of row_counts[i] + kRowSlack slots; returns the total. One small host copy.
+    inline std::size_t lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts);
+    // Fills every row; returns how many rows overflowed (their counts are still exact).
+    inline std::size_t fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
+                            View<std::uint32_t> row_counts);
 
    private:
-    DeviceArray<std::uint32_t> counts_, offsets_, boundary_begin_, indices_;
-    std::size_t entries_ = 0;
+    DeviceArray<std::uint32_t> capacity_, offsets_, boundary_begin_, row_end_, indices_;
+    std::size_t slots_ = 0;
+    long second_fills_ = 0;
 };
 
-inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius) {
-    const Real r2 = radius * radius;
-    counts_.resize(fluid_count);
-    boundary_begin_.resize(fluid_count);
+inline std::size_t NeighborList::lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts) {
+    capacity_.resize(fluid_count);
     offsets_.resize(fluid_count + 1);
-    View<std::uint32_t> counts = counts_.view(), boundary_begin = boundary_begin_.view();  // begin: fill pass
-    parallel_for("neighbor_list_count", fluid_count, [=] MW_HD(std::size_t i) {
-        const Vec3 xi = position[i];
-        std::uint32_t count = 0;
-        auto within = [&](std::uint32_t j) { count += norm2(xi - position[j]) < r2; };
-        grid.for_each_fluid(xi, within);
-        grid.for_each_static(xi, within);
-        grid.for_each_solid(xi, within);
-        counts[i] = count;
-    });
-    // One small host copy: the total sizes the index array (which only ever grows).
-    entries_ = exclusive_scan("neighbor_list_offsets", counts_.cview(), View<std::uint32_t>{offsets_.view().data(), fluid_count});
-    const std::uint32_t total = static_cast<std::uint32_t>(entries_);
-    offsets_.upload_range(&total, fluid_count, 1);
+    View<std::uint32_t> capacity = capacity_.view();
+    parallel_for("neighbor_list_capacity", fluid_count,
+                 [=] MW_HD(std::size_t i) { capacity[i] = row_counts[i] + kRowSlack; });
+    const std::size_t total =
+        exclusive_scan("neighbor_list_offsets", capacity_.cview(), View<std::uint32_t>{offsets_.view().data(), fluid_count});
+    const std::uint32_t total32 = static_cast<std::uint32_t>(total);
+    offsets_.upload_range(&total32, fluid_count, 1);
     // Lists grow as a flow spreads along walls or compresses; a quarter of headroom keeps the
     // reallocation (and its first-touch page faults) out of almost every step.
-    if (entries_ > indices_.capacity()) indices_.resize(entries_ + entries_ / 4 + 1);
+    if (total > indices_.capacity()) indices_.resize(total + total / 4 + 1);
+    return total;
+}
+
+inline std::size_t NeighborList::fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position,
+                                      Real radius, View<std::uint32_t> row_counts) {
+    const Real r2 = radius * radius;
+    boundary_begin_.resize(fluid_count);
+    row_end_.resize(fluid_count);
     View<const std::uint32_t> offsets = offsets_.cview();
+    View<std::uint32_t> boundary_begin = boundary_begin_.view(), row_end = row_end_.view();
     std::uint32_t* indices = indices_.view().data();
     // Branch-free fill (whether a candidate is in range is unpredictable; with a branch the fill
-    // took 2.7 times as long as the count pass, without one 1.6 times): every candidate is
-    // written, the cursor advances only for those in range. Once i's row is full, writes go to a local dummy so that they never touch
-    // the next particle's row, which another thread may be filling.
+    // took 2.7 times as long as a counting pass, without one 1.6 times): every candidate is
+    // written, the cursor advances only for those in range. Past the row's last slot, writes go
+    // to a local dummy, so they never touch the next row, which another thread may be filling.
     parallel_for("neighbor_list_fill", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i];
-        const std::uint32_t row_end = offsets[i + 1];
-        std::uint32_t k = offsets[i];
-        std::uint32_t overflow = 0;
+        const std::uint32_t first = offsets[i], last = offsets[i + 1];
+        std::uint32_t k = first;
+        std::uint32_t dummy = 0;
         auto add = [&](std::uint32_t j) {
-            std::uint32_t* slot = k < row_end ? indices + k : &overflow;
+            std::uint32_t* slot = k < last ? indices + k : &dummy;
             *slot = j;
             k += norm2(xi - position[j]) < r2;
         };
@@ -107,7 +134,22 @@ inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, V
         boundary_begin[i] = k;
         grid.for_each_static(xi, add);
         grid.for_each_solid(xi, add);
+        row_end[i] = k;
+        row_counts[i] = k - first;
     });
+    View<const std::uint32_t> counts = row_counts, capacity = capacity_.cview();
+    return transform_reduce("neighbor_list_overflow", fluid_count, std::size_t(0), SumOp{},
+                            [=] MW_HD(std::size_t i) { return std::size_t(counts[i] > capacity[i]); });
+}
+
+inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
+                                View<std::uint32_t> row_counts) {
+    slots_ = lay_out_rows(fluid_count, row_counts);
+    if (fill(grid, fluid_count, position, radius, row_counts) == 0) return;
+    // Some row overflowed: row_counts now holds every exact count, so the second fill fits.
+    ++second_fills_;
+    slots_ = lay_out_rows(fluid_count, row_counts);
+    fill(grid, fluid_count, position, radius, row_counts);
 }
 
 MW_BACKEND_END

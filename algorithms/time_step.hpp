@@ -38,7 +38,7 @@ class BackendSimulation final : public Simulation {
             // (Δ/h)³, for the ≤ Δt·|v_i - v_j| it moved. A skin of 2 Δt v_max would have doubled
             // the lists (and the PCISPH time) in the fast phase of a dam break for no change in
             // the density error (measured: docs/solver.md).
-            lists_.build(grid, fluid_count, store_.position.cview(), fluid_.kernel.h);
+            lists_.build(grid, fluid_count, store_.position.cview(), fluid_.kernel.h, neighbor_count_->view());
         }
         timers_.stop(kNeighbors);
 
@@ -201,6 +201,7 @@ class BackendSimulation final : public Simulation {
     NeighborGrid grid_;
     NeighborList lists_;
     bool use_lists_ = false;
+    DeviceArray<std::uint32_t>* neighbor_count_ = nullptr;  // store field: each particle's list length, sizes next step's row
     GroupRanges ranges_;
     DeviceArray<Real> boundary_volume_;  // V_b, indexed like the store (fluid entries unused)
     DeviceArray<Vec3> nonpressure_;      // gravity + viscosity; only when μ > 0
@@ -290,6 +291,12 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     use_lists_ = has_fluid_ && (params_.neighbor_lists == SimulationParams::Lists::kAuto
                                     ? kPrefersNeighborLists
                                     : params_.neighbor_lists == SimulationParams::Lists::kOn);
+    if (use_lists_) {
+        // Registered before the first sort, so that it travels with the particles from the start;
+        // 0 makes the first build lay its rows out from exact counts (one second fill).
+        neighbor_count_ = &store_.add<std::uint32_t>("neighbor_count", FieldLife::kPersistent);
+        neighbor_count_->fill(0);
+    }
     has_viscosity_ = has_fluid_ && (fp.viscosity > 0 || (fp.wall_viscosity > 0 && store_.static_count() > 0));
     has_solid_volumes_ = solids_.active() && has_fluid_;
 
@@ -317,7 +324,7 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     ranges_ = grid_.build(store_);
     if (solids_.active()) solids_.update_slot_map(store_);
     if (use_lists_)
-        lists_.build(grid_.view(), ranges_.fluid_end, store_.position.cview(), fluid_.kernel.h);
+        lists_.build(grid_.view(), ranges_.fluid_end, store_.position.cview(), fluid_.kernel.h, neighbor_count_->view());
 
     // The first CFL step uses the initial speeds.
     double max_speed2 = 0;

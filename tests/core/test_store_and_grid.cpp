@@ -94,6 +94,18 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> nanoflann_pairs(const std::vec
     return pairs;
 }
 
+std::set<std::pair<std::uint32_t, std::uint32_t>> list_pairs(const NeighborListView& rows,
+                                                            const std::vector<std::uint32_t>& sorted_id) {
+    std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t i = 0; i < sorted_id.size(); ++i) {
+        CHECK(rows.boundary_begin[i] == rows.row_end[i]);  // no boundary particles here
+        CHECK(rows.row_end[i] <= rows.offsets[i + 1]);
+        for (std::uint32_t k = rows.offsets[i]; k < rows.row_end[i]; ++k)
+            if (rows.indices[k] != i) pairs.insert({sorted_id[i], sorted_id[rows.indices[k]]});
+    }
+    return pairs;
+}
+
 std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<Vec3>& points, Vec3 lo, Vec3 hi, Real h,
                                                             CellOrdering ordering, int cells_per_h,
                                                             bool with_lists = false) {
@@ -122,14 +134,10 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<V
     }
     // The CSR lists the PCISPH gathers read on CPU cores (branch-free fill), radius h.
     NeighborList lists;
-    lists.build(view, n, store.position.cview(), h);
-    const NeighborListView rows = lists.view();
-    for (std::size_t i = 0; i < n; ++i) {
-        CHECK(rows.boundary_begin[i] == rows.offsets[i + 1]);  // no boundary particles here
-        for (std::uint32_t k = rows.offsets[i]; k < rows.offsets[i + 1]; ++k)
-            if (rows.indices[k] != i) pairs.insert({sorted_id[i], sorted_id[rows.indices[k]]});
-    }
-    return pairs;
+    DeviceArray<std::uint32_t> row_counts(n);
+    row_counts.fill(0);
+    lists.build(view, n, store.position.cview(), h, row_counts.view());
+    return list_pairs(lists.view(), sorted_id);
 }
 }  // namespace
 
@@ -163,6 +171,56 @@ TEST_CASE("grid neighbours and neighbour lists equal nanoflann's radius search")
         CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kZOrder, cells_per_h) == expected);
         CHECK(grid_pairs(points, grid_lo, grid_hi, h, CellOrdering::kZOrder, cells_per_h, true) == expected);
     }
+}
+
+TEST_CASE("neighbour lists stay exact when counts grow past their slack") {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<Real> unit(0, 1);
+    const Real h = Real(0.05);
+    std::vector<Vec3> points;
+    for (int i = 0; i < 5000; ++i) points.push_back({unit(rng), unit(rng) * Real(0.5), unit(rng) * Real(0.3)});
+    const std::size_t n = points.size();
+    ParticleStore store;
+    store.resize(n, n);
+    std::vector<std::uint32_t> id(n);
+    std::iota(id.begin(), id.end(), 0u);
+    store.id.upload(id);
+    store.position.upload(points);
+    store.type.fill(kFluid);
+    NeighborGrid grid;
+    grid.configure({-h, -h, -h}, {1 + h, Real(0.5) + h, Real(0.3) + h}, h, CellOrdering::kZOrder);
+    DeviceArray<std::uint32_t>& row_counts = store.add<std::uint32_t>("neighbor_count", FieldLife::kPersistent);
+    row_counts.fill(0);
+    NeighborList lists;
+
+    // 1. No counts yet: every row overflows its slack, and the second fill makes it exact.
+    grid.build(store);
+    lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
+    CHECK(lists.second_fills() == 1);
+    CHECK(list_pairs(lists.view(), store.id.to_host()) == nanoflann_pairs(points, h));
+    // 2. Particles moved a little (re-sorted, counts carried along): one fill suffices.
+    for (Vec3& p : points) p = p + Vec3{Real(0.002) * (unit(rng) - Real(0.5)), 0, 0};
+    std::vector<Vec3> moved(n);
+    {
+        const auto ids = store.id.to_host();
+        for (std::size_t k = 0; k < n; ++k) moved[k] = points[ids[k]];
+        store.position.upload(moved);
+    }
+    grid.build(store);
+    lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
+    CHECK(lists.second_fills() == 1);
+    CHECK(list_pairs(lists.view(), store.id.to_host()) == nanoflann_pairs(points, h));
+    // 3. Squeezed to 80%: counts nearly double, rows overflow, and the lists are still exact.
+    for (Vec3& p : points) p = Real(0.8) * p;
+    {
+        const auto ids = store.id.to_host();
+        for (std::size_t k = 0; k < n; ++k) moved[k] = points[ids[k]];
+        store.position.upload(moved);
+    }
+    grid.build(store);
+    lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
+    CHECK(lists.second_fills() == 2);
+    CHECK(list_pairs(lists.view(), store.id.to_host()) == nanoflann_pairs(points, h));
 }
 
 TEST_CASE("particles outside the grid are set aside, not lost silently") {
