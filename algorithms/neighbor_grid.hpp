@@ -136,30 +136,16 @@ struct GridView {
         if (static_begin) for_each_in_ranges(static_begin, static_end, x, f);
     }
     // The gather interface shared with NeighborListView (the grid does not need i): sums of f(j)
-    // over the 27 cells' fluid or boundary particles.
+    // over the 27 cells' fluid or boundary particles, of whatever type f returns (Real, Vec3).
     template <class F>
-    MW_INLINE Real sum_fluid(std::size_t, Vec3 x, F&& f) const {
-        Real sum = 0;
+    MW_INLINE auto sum_fluid(std::size_t, Vec3 x, F&& f) const {
+        decltype(f(0u)) sum{};
         for_each_fluid(x, [&](std::uint32_t j) { sum += f(j); });
         return sum;
     }
     template <class F>
-    MW_INLINE Real sum_boundary(std::size_t, Vec3 x, F&& f) const {
-        Real sum = 0;
-        auto add = [&](std::uint32_t b) { sum += f(b); };
-        for_each_static(x, add);
-        for_each_solid(x, add);
-        return sum;
-    }
-    template <class F>
-    MW_INLINE Vec3 sum_fluid3(std::size_t, Vec3 x, F&& f) const {
-        Vec3 sum{0, 0, 0};
-        for_each_fluid(x, [&](std::uint32_t j) { sum += f(j); });
-        return sum;
-    }
-    template <class F>
-    MW_INLINE Vec3 sum_boundary3(std::size_t, Vec3 x, F&& f) const {
-        Vec3 sum{0, 0, 0};
+    MW_INLINE auto sum_boundary(std::size_t, Vec3 x, F&& f) const {
+        decltype(f(0u)) sum{};
         auto add = [&](std::uint32_t b) { sum += f(b); };
         for_each_static(x, add);
         for_each_solid(x, add);

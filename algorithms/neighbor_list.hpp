@@ -9,8 +9,8 @@
 // exact counts and filled a second time. Exact either way: no cap, nothing dropped.
 //
 // The grid (GridView) and the list (NeighborListView) offer the same gather interface: sums of
-// f(j) over i's fluid or boundary neighbours (sum_fluid, sum_boundary, and the 3-vector forms
-// sum_fluid3, sum_boundary3), so the solver is written once for both. f must give 0 by itself for
+// f(j) over i's fluid or boundary neighbours (sum_fluid, sum_boundary; the sum has the type f
+// returns), so the solver is written once for both. f must give 0 by itself for
 // a j out of range, without a branch: the PCISPH gathers ran twice as fast with branch-free terms
 // as with the same terms compiled into branches (docs/solver.md).
 #pragma once
@@ -21,36 +21,23 @@ MW_BACKEND_BEGIN
 struct NeighborListView {
     const std::uint32_t* offsets = nullptr;         // [fluid_count + 1]: first slot of each row
     const std::uint32_t* boundary_begin = nullptr;  // [fluid_count]: first boundary entry of i
-    const std::uint32_t* row_end = nullptr;         // [fluid_count]: one past i's last entry
+    const std::uint32_t* counts = nullptr;          // [fluid_count]: entries in i's row
     const std::uint32_t* indices = nullptr;
 
+    MW_INLINE std::uint32_t row_end(std::size_t i) const { return offsets[i] + counts[i]; }
     template <class F>
-    MW_INLINE Real sum_fluid(std::size_t i, Vec3, F&& f) const {
+    MW_INLINE auto sum_fluid(std::size_t i, Vec3, F&& f) const {
         return sum(offsets[i], boundary_begin[i], f);
     }
     template <class F>
-    MW_INLINE Real sum_boundary(std::size_t i, Vec3, F&& f) const {
-        return sum(boundary_begin[i], row_end[i], f);
-    }
-    template <class F>
-    MW_INLINE Vec3 sum_fluid3(std::size_t i, Vec3, F&& f) const {
-        return sum3(offsets[i], boundary_begin[i], f);
-    }
-    template <class F>
-    MW_INLINE Vec3 sum_boundary3(std::size_t i, Vec3, F&& f) const {
-        return sum3(boundary_begin[i], row_end[i], f);
+    MW_INLINE auto sum_boundary(std::size_t i, Vec3, F&& f) const {
+        return sum(boundary_begin[i], row_end(i), f);
     }
 
    private:
     template <class F>
-    MW_INLINE Real sum(std::uint32_t begin, std::uint32_t end, F& f) const {
-        Real total = 0;
-        for (std::uint32_t k = begin; k < end; ++k) total += f(indices[k]);
-        return total;
-    }
-    template <class F>
-    MW_INLINE Vec3 sum3(std::uint32_t begin, std::uint32_t end, F& f) const {
-        Vec3 total{0, 0, 0};
+    MW_INLINE auto sum(std::uint32_t begin, std::uint32_t end, F& f) const {
+        decltype(f(0u)) total{};
         for (std::uint32_t k = begin; k < end; ++k) total += f(indices[k]);
         return total;
     }
@@ -65,56 +52,51 @@ class NeighborList {
     static constexpr std::uint32_t kRowSlack = 16;
 
     // Lists for fluid particles [0, fluid_count) within `radius` of their current positions.
-    // row_counts[i] is i's count from the last build (0 before the first) and receives the new one.
+    // row_counts[i] is i's count from the last build (0 before the first) and receives the new
+    // one; the lists read it, so it must stay alive and unsorted until the next build.
     inline void build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
                       View<std::uint32_t> row_counts);
     NeighborListView view() const {
-        return NeighborListView{offsets_.view().data(), boundary_begin_.view().data(), row_end_.view().data(),
+        return NeighborListView{offsets_.view().data(), boundary_begin_.view().data(), row_counts_,
                                 indices_.view().data()};
     }
-    std::size_t bytes() const {
-        return capacity_.bytes() + offsets_.bytes() + boundary_begin_.bytes() + row_end_.bytes() + indices_.bytes();
-    }
-    std::size_t slots() const { return slots_; }
+    std::size_t bytes() const { return offsets_.bytes() + boundary_begin_.bytes() + indices_.bytes(); }
     long second_fills() const { return second_fills_; }  // builds that needed a second fill
 
     // The two steps of build(). Public only because nvcc allows no device lambda inside a
     // private member function.
-    // Rows of row_counts[i] + kRowSlack slots; returns the total. One small host copy.
-    inline std::size_t lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts);
-    // Fills every row; returns how many rows overflowed (their counts are still exact).
+    // Rows of row_counts[i] + kRowSlack slots. One small host copy (the total, to size indices).
+    inline void lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts);
+    // Fills every row and records the exact counts; returns how many rows overflowed.
     inline std::size_t fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
                             View<std::uint32_t> row_counts);
 
    private:
-    DeviceArray<std::uint32_t> capacity_, offsets_, boundary_begin_, row_end_, indices_;
-    std::size_t slots_ = 0;
+    DeviceArray<std::uint32_t> offsets_, boundary_begin_, indices_;
+    const std::uint32_t* row_counts_ = nullptr;
     long second_fills_ = 0;
 };
 
-inline std::size_t NeighborList::lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts) {
-    capacity_.resize(fluid_count);
+inline void NeighborList::lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts) {
     offsets_.resize(fluid_count + 1);
-    View<std::uint32_t> capacity = capacity_.view();
-    parallel_for("neighbor_list_capacity", fluid_count,
-                 [=] MW_HD(std::size_t i) { capacity[i] = row_counts[i] + kRowSlack; });
-    const std::size_t total =
-        exclusive_scan("neighbor_list_offsets", capacity_.cview(), View<std::uint32_t>{offsets_.view().data(), fluid_count});
-    const std::uint32_t total32 = static_cast<std::uint32_t>(total);
-    offsets_.upload_range(&total32, fluid_count, 1);
+    // Row sizes, and a 0 after the last, so that the in-place scan leaves the total in
+    // offsets[fluid_count] without an upload.
+    View<std::uint32_t> offsets = offsets_.view();
+    parallel_for("neighbor_list_row_sizes", fluid_count + 1, [=] MW_HD(std::size_t i) {
+        offsets[i] = i < fluid_count ? row_counts[i] + kRowSlack : 0u;
+    });
+    const std::size_t total = exclusive_scan("neighbor_list_offsets", offsets_.cview(), offsets);
     // Lists grow as a flow spreads along walls or compresses; a quarter of headroom keeps the
     // reallocation (and its first-touch page faults) out of almost every step.
     if (total > indices_.capacity()) indices_.resize(total + total / 4 + 1);
-    return total;
 }
 
 inline std::size_t NeighborList::fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position,
                                       Real radius, View<std::uint32_t> row_counts) {
     const Real r2 = radius * radius;
     boundary_begin_.resize(fluid_count);
-    row_end_.resize(fluid_count);
     View<const std::uint32_t> offsets = offsets_.cview();
-    View<std::uint32_t> boundary_begin = boundary_begin_.view(), row_end = row_end_.view();
+    View<std::uint32_t> boundary_begin = boundary_begin_.view();
     std::uint32_t* indices = indices_.view().data();
     // Branch-free fill (whether a candidate is in range is unpredictable; with a branch the fill
     // took 2.7 times as long as a counting pass, without one 1.6 times): every candidate is
@@ -134,21 +116,22 @@ inline std::size_t NeighborList::fill(const GridView& grid, std::size_t fluid_co
         boundary_begin[i] = k;
         grid.for_each_static(xi, add);
         grid.for_each_solid(xi, add);
-        row_end[i] = k;
         row_counts[i] = k - first;
     });
-    View<const std::uint32_t> counts = row_counts, capacity = capacity_.cview();
-    return transform_reduce("neighbor_list_overflow", fluid_count, std::size_t(0), SumOp{},
-                            [=] MW_HD(std::size_t i) { return std::size_t(counts[i] > capacity[i]); });
+    View<const std::uint32_t> counts = row_counts;
+    return transform_reduce("neighbor_list_overflow", fluid_count, std::size_t(0), SumOp{}, [=] MW_HD(std::size_t i) {
+        return std::size_t(offsets[i] + counts[i] > offsets[i + 1]);
+    });
 }
 
 inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
                                 View<std::uint32_t> row_counts) {
-    slots_ = lay_out_rows(fluid_count, row_counts);
+    row_counts_ = row_counts.data();
+    lay_out_rows(fluid_count, row_counts);
     if (fill(grid, fluid_count, position, radius, row_counts) == 0) return;
     // Some row overflowed: row_counts now holds every exact count, so the second fill fits.
     ++second_fills_;
-    slots_ = lay_out_rows(fluid_count, row_counts);
+    lay_out_rows(fluid_count, row_counts);
     fill(grid, fluid_count, position, radius, row_counts);
 }
 

@@ -140,11 +140,11 @@ void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<co
         const Vec3 xi = predicted[i];
         const Real pi_rho2 = pressure_term[i];
         // Out-of-range pairs and i itself contribute a zero gradient, so no test is needed.
-        const Vec3 fluid_sum = neighbors.sum_fluid3(i, position[i], [&](std::uint32_t j) {
+        const Vec3 fluid_sum = neighbors.sum_fluid(i, position[i], [&](std::uint32_t j) {
             const Vec3 d = xi - predicted[j];
             return (pi_rho2 + pressure_term[j]) * c.kernel.grad_W_r2(d, norm2(d));
         });
-        const Vec3 boundary_sum = neighbors.sum_boundary3(i, position[i], [&](std::uint32_t b) {
+        const Vec3 boundary_sum = neighbors.sum_boundary(i, position[i], [&](std::uint32_t b) {
             const Vec3 d = xi - position[b];
             return boundary_volume[b] * c.kernel.grad_W_r2(d, norm2(d));
         });

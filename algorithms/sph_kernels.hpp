@@ -27,46 +27,38 @@ struct CubicSpline3D {
         k.visc_scale = Real(45) / (kPi * support * support * support * support * support * support);
         return k;
     }
-    // Branch-free form of the two pieces: for q ≤ 1/2, 2(1-q)³ - 8(1/2-q)³ = 6(q³-q²) + 1.
-    MW_INLINE Real W(Real r) const {
-        const Real q = r * inv_h;
-        if (q >= Real(1)) return Real(0);
-        const Real a = Real(1) - q;
-        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
-        return sigma * (Real(2) * a * a * a - Real(8) * b * b * b);
-    }
-    // ∇_i W(x_i - x_j) for r_vec = x_i - x_j, |r_vec| = r (passed in because callers have it).
-    // dW/dq / σ = -6(1-q)² + 24 max(1/2-q, 0)², equal to 6q(3q-2) for q ≤ 1/2.
-    MW_INLINE Vec3 grad_W(Vec3 r_vec, Real r) const {
-        const Real q = r * inv_h;
-        if (q >= Real(1) || r <= Real(1e-9) * h) return Vec3{0, 0, 0};
-        const Real a = Real(1) - q;
-        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
-        const Real dwdq = Real(4) * b * b - a * a;  // (dW/dq) / (6σ)
-        return (grad_scale * dwdq / r) * r_vec;
-    }
-    // The forms the neighbour sums use: from |r_vec|², with selects and no branches, and 0 by
-    // themselves out of range, so a sum needs no test per neighbour (whether a neighbour is in
-    // range is unpredictable; the branch-free sums measured twice as fast, docs/solver.md).
-    // W for r ≥ h is 0.
-    MW_INLINE Real W_r2(Real r2) const {
-        const Real q = std::sqrt(r2) * inv_h;
+    // The two pieces without branches (selects only): a = max(1-q, 0), b = max(1/2-q, 0);
+    // for q ≤ 1/2, 2(1-q)³ - 8(1/2-q)³ = 6(q³-q²) + 1; both vanish for q ≥ 1.
+    MW_INLINE Real W_of_q(Real q) const {
         const Real a = Real(1) - q > Real(0) ? Real(1) - q : Real(0);
         const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
         return sigma * (Real(2) * a * a * a - Real(8) * b * b * b);
     }
-    // ∇W from r_vec and |r_vec|², without branches: 0 for r ≥ h and for r = 0 (a particle and
-    // itself).
+    // |∇W| / r-direction factor: grad_scale (4b² - a²), i.e. (dW/dq)/h with
+    // dW/dq / σ = -6(1-q)² + 24 max(1/2-q, 0)², equal to 6q(3q-2) for q ≤ 1/2.
+    MW_INLINE Real dW_of_q(Real q) const {
+        const Real a = Real(1) - q > Real(0) ? Real(1) - q : Real(0);
+        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
+        return grad_scale * (Real(4) * b * b - a * a);
+    }
+    MW_INLINE Real W(Real r) const { return W_of_q(r * inv_h); }
+    // ∇_i W(x_i - x_j) for r_vec = x_i - x_j, |r_vec| = r (passed in because callers have it).
+    MW_INLINE Vec3 grad_W(Vec3 r_vec, Real r) const {
+        if (r <= Real(1e-9) * h) return Vec3{0, 0, 0};
+        return (dW_of_q(r * inv_h) / r) * r_vec;
+    }
+    // The forms the neighbour sums use: from |r_vec|², with no branch at all, and 0 by themselves
+    // out of range, so a sum needs no test per neighbour (whether a neighbour is in range is
+    // unpredictable; the branch-free sums measured twice as fast, docs/solver.md).
+    MW_INLINE Real W_r2(Real r2) const { return W_of_q(std::sqrt(r2) * inv_h); }
+    // 0 also for r = 0 (a particle and itself). The division is not conditional (a conditional
+    // one could trap, which stops the compiler from turning it into a select): r = 0 divides by 1
+    // and is masked after.
     MW_INLINE Vec3 grad_W_r2(Vec3 r_vec, Real r2) const {
-        // The division is not conditional (a conditional one could trap, which stops the compiler
-        // from turning it into a select): r = 0 divides by 1 and is masked after.
         const bool apart = r2 > Real(1e-18) * h * h;
         const Real r = std::sqrt(r2);
         const Real inv_r = apart ? Real(1) / (apart ? r : Real(1)) : Real(0);
-        const Real q = r * inv_h;
-        const Real a = Real(1) - q > Real(0) ? Real(1) - q : Real(0);
-        const Real b = Real(0.5) - q > Real(0) ? Real(0.5) - q : Real(0);
-        return (grad_scale * (Real(4) * b * b - a * a) * inv_r) * r_vec;
+        return (dW_of_q(r * inv_h) * inv_r) * r_vec;
     }
     // Laplacian of the viscosity kernel; never negative, so viscosity never injects energy.
     MW_INLINE Real laplacian_visc(Real r) const { return r < h ? visc_scale * (h - r) : Real(0); }

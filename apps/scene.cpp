@@ -571,12 +571,26 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
     }
     if (!raw.is_object()) throw InputError(source + ": a scene must be a JSON object { ... }, got " + type_name(raw));
     Scene scene = resolve_scene(raw, source);
+    // Overrides are checked together, not one by one: values that depend on each other (spacing
+    // and support radius) may only be valid once both are set. Each key path is checked against
+    // the last scene that resolved.
+    bool resolved_last = true;
     for (const auto& o : overrides) {
         apply_override(raw, scene.resolved, o);
         try {
             scene = resolve_scene(raw, source);
+            resolved_last = true;
+        } catch (const InputError&) {
+            resolved_last = false;  // a later --set may make it valid; the final check reports it
+        }
+    }
+    if (!resolved_last) {
+        try {
+            scene = resolve_scene(raw, source);
         } catch (const InputError& e) {
-            throw InputError(std::string(e.what()) + " (after --set " + o + ")");
+            std::string list;
+            for (const auto& o : overrides) list += (list.empty() ? "" : ", ") + std::string("--set ") + o;
+            throw InputError(std::string(e.what()) + " (after " + list + ")");
         }
     }
     return scene;

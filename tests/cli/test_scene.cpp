@@ -101,6 +101,22 @@ TEST_CASE("--set overrides reach every kind of key") {
     CHECK(t.params.fluid.support_radius == doctest::Approx(0.02));
 }
 
+TEST_CASE("--set overrides that depend on each other are checked together, in any order") {
+    // Spacing alone would leave the old support radius out of its range, and the other way round.
+    // (The first override makes the support radius explicit, so it no longer follows the spacing.)
+    for (const auto& overrides :
+         {std::vector<std::string>{"fluid.support_radius=0.04", "fluid.spacing=0.005", "fluid.support_radius=0.01"},
+          std::vector<std::string>{"fluid.support_radius=0.01", "fluid.spacing=0.005"}}) {
+        const Scene s = parse_scene_text(tiny_scene_text(), "t", overrides);
+        CHECK(s.params.fluid.spacing == doctest::Approx(0.005));
+        CHECK(s.params.fluid.support_radius == doctest::Approx(0.01));
+    }
+    // A combination that stays invalid is reported once, naming the key and the overrides.
+    const std::string message = parse_error(tiny_scene_text(), {"fluid.spacing=0.005", "fluid.support_radius=0.5"});
+    CHECK(contains(message, "fluid.support_radius"));
+    CHECK(contains(message, "--set fluid.spacing=0.005, --set fluid.support_radius=0.5"));
+}
+
 TEST_CASE("bad scenes give one line naming the key") {
     struct Case {
         const char* what;

@@ -98,9 +98,9 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> list_pairs(const NeighborListV
                                                             const std::vector<std::uint32_t>& sorted_id) {
     std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
     for (std::size_t i = 0; i < sorted_id.size(); ++i) {
-        CHECK(rows.boundary_begin[i] == rows.row_end[i]);  // no boundary particles here
-        CHECK(rows.row_end[i] <= rows.offsets[i + 1]);
-        for (std::uint32_t k = rows.offsets[i]; k < rows.row_end[i]; ++k)
+        CHECK(rows.boundary_begin[i] == rows.row_end(i));  // no boundary particles here
+        CHECK(rows.row_end(i) <= rows.offsets[i + 1]);
+        for (std::uint32_t k = rows.offsets[i]; k < rows.row_end(i); ++k)
             if (rows.indices[k] != i) pairs.insert({sorted_id[i], sorted_id[rows.indices[k]]});
     }
     return pairs;
@@ -198,25 +198,23 @@ TEST_CASE("neighbour lists stay exact when counts grow past their slack") {
     lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
     CHECK(lists.second_fills() == 1);
     CHECK(list_pairs(lists.view(), store.id.to_host()) == nanoflann_pairs(points, h));
+    // Moves the store's particles (in their sorted order) to `points` (indexed by id).
+    auto move_store_to = [&](const std::vector<Vec3>& target) {
+        const auto ids = store.id.to_host();
+        std::vector<Vec3> sorted(n);
+        for (std::size_t k = 0; k < n; ++k) sorted[k] = target[ids[k]];
+        store.position.upload(sorted);
+    };
     // 2. Particles moved a little (re-sorted, counts carried along): one fill suffices.
     for (Vec3& p : points) p = p + Vec3{Real(0.002) * (unit(rng) - Real(0.5)), 0, 0};
-    std::vector<Vec3> moved(n);
-    {
-        const auto ids = store.id.to_host();
-        for (std::size_t k = 0; k < n; ++k) moved[k] = points[ids[k]];
-        store.position.upload(moved);
-    }
+    move_store_to(points);
     grid.build(store);
     lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
     CHECK(lists.second_fills() == 1);
     CHECK(list_pairs(lists.view(), store.id.to_host()) == nanoflann_pairs(points, h));
     // 3. Squeezed to 80%: counts nearly double, rows overflow, and the lists are still exact.
     for (Vec3& p : points) p = Real(0.8) * p;
-    {
-        const auto ids = store.id.to_host();
-        for (std::size_t k = 0; k < n; ++k) moved[k] = points[ids[k]];
-        store.position.upload(moved);
-    }
+    move_store_to(points);
     grid.build(store);
     lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
     CHECK(lists.second_fills() == 2);
