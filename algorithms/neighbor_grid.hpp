@@ -186,6 +186,9 @@ class NeighborGrid {
         shape_.morton_bits = bits;
         begin_.resize(2 * std::size_t(count));
         end_.resize(2 * std::size_t(count));
+        // Once: the linear-order gather reads the begin of empty cells too (then ignores it), and
+        // a value never written would be a read of uninitialised memory to compute-sanitizer.
+        begin_.fill(0);
     }
     const GridShape& shape() const { return shape_; }
     bool uses_zorder() const { return shape_.zorder; }
@@ -298,7 +301,8 @@ inline void NeighborGrid::build_static(ParticleStore& store) {
     store.permute(sorted_order_.cview(), first);
     static_begin_.resize(shape.cell_count);
     static_end_.resize(shape.cell_count);
-    static_end_.fill(0);  // ends only, as in build()
+    static_begin_.fill(0);  // once per static build; see configure()
+    static_end_.fill(0);
     View<const std::uint8_t> type{store.type.view().data() + first, n};
     fill_cell_ranges(shape, position, type, false, n, first, static_begin_.view().data(), static_end_.view().data(),
                      nullptr);

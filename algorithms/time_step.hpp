@@ -135,13 +135,18 @@ class BackendSimulation final : public Simulation {
             predict_density_and_pressure(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
                                          boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
                                          pressure_term_.view(), fluid_, delta, first);
-            error = density_error(fluid_count, store_.density.cview(), fluid_.rest_density);
             pressure_acceleration(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
                                   boundary_volume_.cview(), pressure_term_.cview(), pressure_acc_.view(), fluid_);
             ++iterations;
+            // The error is a reduction read back by the host (a synchronisation on a GPU), so it is
+            // computed only where it can end the loop: from the min_iterations-th iteration on. It
+            // comes after the pressure force, which does not change the densities, so the force
+            // kernel is already queued while the host waits.
+            if (iterations < solver.min_iterations && iterations < solver.max_iterations) continue;
+            error = density_error(fluid_count, store_.density.cview(), fluid_.rest_density);
             const double average = fluid_count ? error.sum / double(fluid_count) : 0.0;
             const bool peak_ok = solver.eta_max <= 0 || error.max <= solver.eta_max;
-            if (iterations >= solver.min_iterations && average <= solver.eta && peak_ok) break;
+            if (average <= solver.eta && peak_ok) break;
         }
         return error;
     }
@@ -300,9 +305,11 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     has_viscosity_ = has_fluid_ && (fp.viscosity > 0 || (fp.wall_viscosity > 0 && store_.static_count() > 0));
     has_solid_volumes_ = solids_.active() && has_fluid_;
 
-    // Boundary volumes only matter to fluid: without fluid they are neither stored nor computed.
+    // Boundary volumes only matter to fluid next to boundary particles: without fluid, or without
+    // any boundary particle, they are neither stored nor computed. They are indexed like the store
+    // (fluid entries unused) so that a particle changing type (melting) needs no re-indexing.
     if (has_fluid_) {
-        boundary_volume_.resize(n);
+        if (store_.static_count() || solids_.active()) boundary_volume_.resize(n);
         if (store_.static_count())
             compute_boundary_volumes(grid_.view(), store_.position.cview(), boundary_volume_.view(), moving,
                                      store_.static_count(), false, fluid_.kernel);

@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -35,6 +37,13 @@ void make_directories(const std::string& path) {
     std::filesystem::create_directories(path, error);
     if (error || !std::filesystem::is_directory(path))
         throw InputError("cannot create output directory " + path + (error ? ": " + error.message() : ""));
+    // An existing directory may still be read-only: find out now, not after a long run.
+    const std::string probe = path + "/.meltwater-write-check." + std::to_string(::getpid());
+    {
+        std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+        if (!out) throw InputError("cannot write in output directory " + path + ": " + std::strerror(errno));
+    }
+    std::remove(probe.c_str());
 }
 
 }  // namespace mw

@@ -62,17 +62,25 @@ std::string choose_backend(const std::string& requested) {
     throw InputError("--backend: expected auto, cuda or openmp, got '" + requested + "'");
 }
 
+std::unique_ptr<Simulation> probe_on_host(SimulationSetup setup, const std::string& backend) {
+    const BackendInfo target = backend == "cuda" ? cuda_backend_info() : openmp_backend_info();
+    SimulationParams::Lists& lists = setup.params.neighbor_lists;
+    if (lists == SimulationParams::Lists::kAuto)
+        lists = target.prefers_neighbor_lists ? SimulationParams::Lists::kOn : SimulationParams::Lists::kOff;
+    return create_openmp_simulation(setup, 0);
+}
+
 std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, const std::string& backend, int threads) {
     if (backend == "openmp") return create_openmp_simulation(setup, threads);
     try {
         return create_cuda_simulation(setup);
     } catch (const DeviceError& e) {
-        // Add what the scene asks for, measured on the host backend (same layout), when cheap enough.
-        std::string estimate;
-        if (setup.position.size() <= 20'000'000) {
+        // Add what the scene needs on the GPU, measured on the host, when that is cheap enough
+        // (a few hundred MB of host memory at most); otherwise point to `info`.
+        std::string estimate = "; 'meltwater info --backend cuda' gives the memory it needs";
+        if (setup.position.size() <= 5'000'000) {
             try {
-                auto probe = create_openmp_simulation(setup, 1);
-                estimate = ", estimated " + format_bytes(double(probe->device_bytes()));
+                estimate = ", which need " + format_bytes(double(probe_on_host(setup, "cuda")->device_bytes())) + " on the GPU";
             } catch (const std::exception&) {
             }
         }

@@ -28,6 +28,11 @@ Scene scene_from_options(const cxxopts::ParseResult& result, const std::vector<s
 // unknown name and DeviceError when CUDA is asked for and unavailable.
 std::string choose_backend(const std::string& requested);
 
+// A simulation of `setup` built on the host backend with the memory layout `backend` ("cuda" or
+// "openmp") would use: neighbour lists or grid gathers, the only part of the layout that differs.
+// Its device_bytes() is what the scene needs on that backend; it allocates all of it on the host.
+std::unique_ptr<Simulation> probe_on_host(SimulationSetup setup, const std::string& backend);
+
 // Creates the simulation on the chosen backend; a DeviceError on creation (out of GPU memory) is
 // re-thrown with the particle count and the memory estimate.
 std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, const std::string& backend, int threads);

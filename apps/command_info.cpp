@@ -15,7 +15,9 @@ int command_info(int argc, char** argv) {
                              "Particle counts by type, the memory estimate and the stages a run of SCENE\n"
                              "(the built-in 3D dam break when omitted) would use.");
     add_scene_options(options);
-    options.add_options()("json", "print one JSON object instead of text");
+    options.add_options()("json", "print one JSON object instead of text")(
+        "backend", "the backend whose memory layout to estimate: auto (what run would use), cuda or openmp",
+        cxxopts::value<std::string>()->default_value("auto"));
     std::vector<std::string> overrides;
     const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
     if (args.count("help")) {
@@ -25,10 +27,15 @@ int command_info(int argc, char** argv) {
     const Scene scene = scene_from_options(args, overrides);
     const SimulationSetup setup = build_setup(scene);
     const ParticleCounts counts = count_particles(setup);
-    // The layout is the same on both backends: measure it on the host one.
-    std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
-    const std::size_t bytes = sim->device_bytes();
-    const std::vector<std::string> stages = sim->stage_names();
+    // The estimate is measured on the host backend with the target backend's layout; a GPU need
+    // not be present to estimate for one.
+    const std::string requested = args["backend"].as<std::string>();
+    if (requested != "auto" && requested != "cuda" && requested != "openmp")
+        throw InputError("--backend: expected auto, cuda or openmp, got '" + requested + "'");
+    const std::string backend = requested == "auto" ? choose_backend("auto") : requested;
+    const std::unique_ptr<Simulation> probe = probe_on_host(setup, backend);
+    const std::size_t bytes = probe->device_bytes();
+    const std::vector<std::string> stages = probe->stage_names();
     const double bytes_per_particle = counts.total() ? double(bytes) / double(counts.total()) : 0.0;
     const SolverParams& solver = scene.params.solver;
     const bool cfl = solver.dt_mode == TimeStepMode::kCfl;
@@ -42,6 +49,7 @@ int command_info(int argc, char** argv) {
         for (int t = 0; t < kParticleTypeCount; ++t) p[particle_type_name(t)] = counts.by_type[t];
         p["total"] = counts.total();
         j["particles"] = p;
+        j["backend"] = backend;
         j["device_bytes"] = bytes;
         j["bytes_per_particle"] = bytes_per_particle;
         j["stages"] = stages;
@@ -56,8 +64,8 @@ int command_info(int argc, char** argv) {
     for (int t = 0; t < kParticleTypeCount; ++t)
         std::printf(" %s %s |", particle_type_name(t), with_thousands(counts.by_type[t]).c_str());
     std::printf(" total %s\n", with_thousands(counts.total()).c_str());
-    std::printf("memory      %s estimated on the device (%.0f bytes/particle)\n", format_bytes(double(bytes)).c_str(),
-                bytes_per_particle);
+    std::printf("memory      %s on the %s backend (%.0f bytes/particle; its layout, measured on the host)\n",
+                format_bytes(double(bytes)).c_str(), backend.c_str(), bytes_per_particle);
     std::printf("stages     ");
     for (std::size_t i = 0; i < stages.size(); ++i) std::printf("%s %s", i ? "," : "", stages[i].c_str());
     std::printf("\n");

@@ -1,4 +1,5 @@
 // `meltwater run [SCENE]`: simulate, writing frames, stats.csv and summary.json into --out.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -71,9 +72,9 @@ int command_run(int argc, char** argv) {
     if (out_dir.empty()) throw InputError("--out: empty directory name");
 
     const SimulationSetup setup = build_setup(scene);
+    make_directories(out_dir);  // before the simulation is built: an unwritable --out fails at once
     std::unique_ptr<Simulation> sim = create_simulation(setup, backend, threads);
 
-    make_directories(out_dir);
     const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
     std::unique_ptr<FrameWriter> frames;
     if (scene.writes_vtu()) {
@@ -104,6 +105,7 @@ int command_run(int argc, char** argv) {
 
     const auto wall_start = std::chrono::steady_clock::now();
     auto last_stats_write = wall_start;
+    double stats_write_seconds = 0;  // how long the last rewrite of stats.csv took
     HostParticles host;
     int frame_index = 0;
     auto write_frame = [&]() {
@@ -147,8 +149,12 @@ int command_run(int argc, char** argv) {
                 // The next frame time after now (a step longer than 1/fps skips frame times).
                 next_frame_time = (std::floor(r.time / frame_dt * (1 + 1e-9)) + 1) * frame_dt;
             }
-            if (seconds_since(last_stats_write) > 5) {  // keep stats.csv current for a run that dies
+            // Keep stats.csv current for a run that dies: every 5 s, or less often once the file
+            // is so long that rewriting it would take more than 5% of the run.
+            if (seconds_since(last_stats_write) > std::max(5.0, 20 * stats_write_seconds)) {
+                const auto write_start = std::chrono::steady_clock::now();
                 stats.write(stats_path);
+                stats_write_seconds = seconds_since(write_start);
                 last_stats_write = std::chrono::steady_clock::now();
             }
         }
@@ -171,16 +177,19 @@ int command_run(int argc, char** argv) {
         summary.status = "interrupted";
     }
     // Whatever happened, leave whole stats.csv and summary.json behind.
+    bool recorded = true;
     try {
         stats.write(stats_path);
         write_summary(summary_path, summary, stats, scene);
     } catch (const std::exception& e) {
         if (!failure) throw;
+        recorded = false;
         std::fprintf(stderr, "meltwater: error: could not record the failure: %s\n", e.what());
     }
     if (failure) {
-        std::fprintf(stderr, "meltwater: stopped after %ld steps at t=%.4g s; %d frames, stats.csv and summary.json kept in %s\n",
-                     summary.steps, summary.simulated_time, summary.frames, out_dir.c_str());
+        std::fprintf(stderr, "meltwater: stopped after %ld steps at t=%.4g s; %d frames%s kept in %s\n", summary.steps,
+                     summary.simulated_time, summary.frames, recorded ? ", stats.csv and summary.json" : "",
+                     out_dir.c_str());
         std::rethrow_exception(failure);
     }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <string>
 
 #include "apps/commands.hpp"
@@ -42,6 +43,11 @@ int main(int argc, char** argv) {
     } catch (const mw::SimulationError& e) {
         std::fprintf(stderr, "meltwater: simulation failed: %s\n", e.what());
         return 4;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr,
+                     "meltwater: error: out of host memory (run 'meltwater info' on the scene for its memory "
+                     "estimate; a coarser fluid.spacing or a smaller scene needs less)\n");
+        return 3;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "meltwater: error: %s\n", e.what());
         return 1;

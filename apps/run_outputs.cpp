@@ -86,9 +86,27 @@ void FrameWriter::write_objects(int index, const HostParticles& p) const {
     }
 }
 
-StatsTable::StatsTable(std::vector<std::string> stage_names) : stages_(std::move(stage_names)) {}
+StatsTable::StatsTable(std::vector<std::string> stage_names)
+    : stages_(std::move(stage_names)), stage_ms_(stages_.size()) {}
 
-void StatsTable::add(const StepReport& report) { reports_.push_back(report); }
+void StatsTable::add(const StepReport& r) {
+    char buffer[160];
+    std::snprintf(buffer, sizeof buffer, "%ld,%.9g,%.9g,%d,%.6g,%.6g,%.6g,%.6g,%ld", r.step, r.time, r.dt, r.iterations,
+                  r.density_error_avg, r.density_error_max, r.max_speed, r.kinetic_energy, r.lost_particles);
+    csv_rows_ += buffer;
+    for (std::size_t s = 0; s < stages_.size(); ++s) {
+        const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
+        std::snprintf(buffer, sizeof buffer, ",%.4f", ms);
+        csv_rows_ += buffer;
+        stage_ms_[s].push_back(ms);
+    }
+    std::snprintf(buffer, sizeof buffer, ",%.4f\n", r.total_ms);
+    csv_rows_ += buffer;
+    total_ms_.push_back(r.total_ms);
+    error_avg_.push_back(r.density_error_avg);
+    error_max_.push_back(r.density_error_max);
+    iterations_.push_back(r.iterations);
+}
 
 std::string StatsTable::header() const {
     std::string h =
@@ -98,70 +116,46 @@ std::string StatsTable::header() const {
 }
 
 void StatsTable::write(const std::string& path) const {
-    write_file_atomically(path, [&](std::ostream& out) {
-        out << header() << '\n';
-        char buffer[96];
-        for (const StepReport& r : reports_) {
-            std::snprintf(buffer, sizeof buffer, "%ld,%.9g,%.9g,%d,", r.step, r.time, r.dt, r.iterations);
-            out << buffer;
-            std::snprintf(buffer, sizeof buffer, "%.6g,%.6g,%.6g,%.6g,%ld", r.density_error_avg, r.density_error_max,
-                          r.max_speed, r.kinetic_energy, r.lost_particles);
-            out << buffer;
-            for (std::size_t s = 0; s < stages_.size(); ++s) {
-                std::snprintf(buffer, sizeof buffer, ",%.4f", s < r.stage_ms.size() ? r.stage_ms[s] : 0.0);
-                out << buffer;
-            }
-            std::snprintf(buffer, sizeof buffer, ",%.4f\n", r.total_ms);
-            out << buffer;
-        }
-    });
+    write_file_atomically(path, [&](std::ostream& out) { out << header() << '\n' << csv_rows_; });
 }
 
 std::vector<double> StatsTable::median_stage_ms() const {
     std::vector<double> out;
-    for (std::size_t s = 0; s < stages_.size(); ++s) {
-        std::vector<double> v;
-        for (const auto& r : reports_) v.push_back(s < r.stage_ms.size() ? r.stage_ms[s] : 0.0);
-        out.push_back(median(v));
-    }
+    for (const auto& column : stage_ms_) out.push_back(median(column));
     return out;
 }
 
-double StatsTable::median_total_ms() const {
-    std::vector<double> v;
-    for (const auto& r : reports_) v.push_back(r.total_ms);
-    return median(v);
-}
+double StatsTable::median_total_ms() const { return median(total_ms_); }
 
 double StatsTable::density_error_avg() const {
-    if (reports_.empty()) return 0;
+    if (error_avg_.empty()) return 0;
     double s = 0;
-    for (const auto& r : reports_) s += r.density_error_avg;
-    return s / reports_.size();
+    for (double e : error_avg_) s += e;
+    return s / double(error_avg_.size());
 }
 
 double StatsTable::density_error_max() const {
     double m = 0;
-    for (const auto& r : reports_) m = std::max(m, r.density_error_max);
+    for (double e : error_max_) m = std::max(m, e);
     return m;
 }
 
 double StatsTable::iterations_avg() const {
-    if (reports_.empty()) return 0;
+    if (iterations_.empty()) return 0;
     double s = 0;
-    for (const auto& r : reports_) s += r.iterations;
-    return s / reports_.size();
+    for (int i : iterations_) s += i;
+    return s / double(iterations_.size());
 }
 
 int StatsTable::iterations_max() const {
     int m = 0;
-    for (const auto& r : reports_) m = std::max(m, r.iterations);
+    for (int i : iterations_) m = std::max(m, i);
     return m;
 }
 
 double StatsTable::sum_total_ms() const {
     double s = 0;
-    for (const auto& r : reports_) s += r.total_ms;
+    for (double t : total_ms_) s += t;
     return s;
 }
 

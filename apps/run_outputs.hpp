@@ -33,7 +33,8 @@ class FrameWriter {
     std::vector<std::pair<double, std::string>> collection_;
 };
 
-// Per-step statistics kept in memory and rewritten atomically (so stats.csv is always whole).
+// Per-step statistics: each row is formatted once, when added, and the whole table is rewritten
+// atomically (so stats.csv is always whole). The numbers the summary needs are kept as columns.
 class StatsTable {
    public:
     explicit StatsTable(std::vector<std::string> stage_names);
@@ -41,7 +42,7 @@ class StatsTable {
     std::string header() const;
     void write(const std::string& path) const;
 
-    std::size_t rows() const { return reports_.size(); }
+    std::size_t rows() const { return total_ms_.size(); }
     const std::vector<std::string>& stage_names() const { return stages_; }
     // Medians of each stage's ms and of the total, in stage order, then "total".
     std::vector<double> median_stage_ms() const;
@@ -54,7 +55,10 @@ class StatsTable {
 
    private:
     std::vector<std::string> stages_;
-    std::vector<StepReport> reports_;
+    std::string csv_rows_;                       // every row so far, as written to stats.csv
+    std::vector<std::vector<double>> stage_ms_;  // [stage][row]
+    std::vector<double> total_ms_, error_avg_, error_max_;
+    std::vector<int> iterations_;
 };
 
 struct RunSummary {

@@ -64,6 +64,19 @@ struct Range {
     }
 };
 
+// A number the simulation's scalar type (Real) holds: in range after the conversion, and not so
+// small that it would turn into zero or a subnormal (a time step of 1e-300, say).
+bool representable(double v) {
+    const double magnitude = std::fabs(v);
+    return magnitude == 0 || (magnitude <= double(std::numeric_limits<Real>::max()) &&
+                              magnitude >= double(std::numeric_limits<Real>::min()));
+}
+std::string representable_range() {
+    return std::string("outside what the simulation's ") + (sizeof(Real) == 4 ? "float" : "double") +
+           " numbers hold (magnitudes " + format_number(double(std::numeric_limits<Real>::min())) + " to " +
+           format_number(double(std::numeric_limits<Real>::max())) + ", or 0)";
+}
+
 // One JSON object of the scene being read. Each getter validates one key, records its resolved
 // value in `out`, and marks the key as known; finish() rejects every key nobody asked for.
 class Section {
@@ -96,6 +109,7 @@ class Section {
         if (!v && !fallback) fail(key_path(key), "required key is missing");
         const double value = v ? to_number(*v, key_path(key)) : *fallback;
         if (!range.contains(value)) fail(key_path(key), "must be " + range.describe() + ", got " + format_number(value));
+        if (!representable(value)) fail(key_path(key), format_number(value) + " is " + representable_range());
         out_[key] = value;
         return value;
     }
@@ -164,6 +178,7 @@ class Section {
                 const std::string p = key_path(key) + "[" + std::to_string(a) + "]";
                 c[a] = to_number((*v)[a], p);
                 if (!range.contains(c[a])) fail(p, "must be " + range.describe() + ", got " + format_number(c[a]));
+                if (!representable(c[a])) fail(p, format_number(c[a]) + " is " + representable_range());
             }
         } else {
             c[0] = (*fallback)[0], c[1] = (*fallback)[1], c[2] = (*fallback)[2];
@@ -286,7 +301,8 @@ void read_fluid(Section s, Scene& scene) {
 
 void read_solver(Section s, Scene& scene) {
     SolverParams& p = scene.params.solver;
-    p.dt = Real(s.number("dt", 0.001, Range{0, 1, true, false}));
+    // Below 1e-7 s a second of simulated time would take ten million steps: a typo, not a choice.
+    p.dt = Real(s.number("dt", 0.001, Range{1e-7, 1, false, false}));
     p.dt_mode = s.choice("dt_mode", "fixed", {"fixed", "cfl"}) == "cfl" ? TimeStepMode::kCfl : TimeStepMode::kFixed;
     p.cfl_number = Real(s.number("cfl_number", 0.4, Range{0, 1, true, false}));
     p.eta = Real(s.number("eta", 0.01, Range{0, 1, true, true}));
@@ -411,7 +427,7 @@ void read_objects(Section& root, Scene& scene) {
 }
 
 void read_run(Section s, Scene& scene) {
-    scene.end_time = s.number("end_time", 1.0, Range::positive());
+    scene.end_time = s.number("end_time", 1.0, Range{0, 1e6, true, false});  // 1e6 s keeps step counts in range
     s.finish();
 }
 
@@ -486,27 +502,39 @@ void apply_override(SceneJson& raw, const SceneJson& resolved, const std::string
         value = SceneJson::parse(text);
     } catch (const SceneJson::parse_error&) {
         value = text;  // not JSON: a plain string (e.g. --set solver.dt_mode=cfl)
+    } catch (const SceneJson::exception&) {
+        throw InputError("--set " + key + ": '" + text + "' is not a representable number");
     }
 
-    // Walk the raw scene along the same path, creating the sections it leaves out.
+    // Walk the raw scene along the same path, creating the sections it leaves out. An earlier
+    // --set may have replaced a section of the raw scene by a value: that is named, not followed.
     SceneJson* node = &raw;
-    const SceneJson* res = &resolved;
-    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    const SceneJson* res = &resolved;  // the same place in the resolved scene, while it has one
+    std::string here;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
         const std::string& p = parts[i];
+        const bool last = i + 1 == parts.size();
         if (node->is_array()) {
+            if (!is_index(p) || std::stoul(p) >= node->size())
+                throw InputError("--set " + key + ": no element " + p + " in " + here + " of the scene");
             const std::size_t idx = std::stoul(p);
-            res = &(*res)[idx];
-            if (idx >= node->size()) throw InputError("--set " + key + ": no element " + p + " in the scene file");
-            node = &(*node)[idx];
+            res = res && res->is_array() && idx < res->size() ? &(*res)[idx] : nullptr;
+            if (last) (*node)[idx] = value;
+            else node = &(*node)[idx];
+        } else if (node->is_object()) {
+            const auto found = res && res->is_object() ? res->find(p) : SceneJson::const_iterator{};
+            res = res && res->is_object() && found != res->end() ? &*found : nullptr;
+            if (last) (*node)[p] = value;
+            else {
+                if (!node->contains(p)) (*node)[p] = res && res->is_array() ? *res : SceneJson::object();
+                node = &(*node)[p];
+            }
         } else {
-            res = &(*res)[p];
-            if (!node->contains(p)) (*node)[p] = res->is_array() ? *res : SceneJson::object();
-            node = &(*node)[p];
+            throw InputError("--set " + key + ": " + here + " is a value in the scene (set by an earlier --set?), "
+                             "not a section");
         }
+        here += (here.empty() ? "" : ".") + p;
     }
-    const std::string& last = parts.back();
-    if (node->is_array()) (*node)[std::stoul(last)] = value;
-    else (*node)[last] = value;
 }
 
 std::string read_file(const std::string& path) {
@@ -562,8 +590,9 @@ Scene parse_scene_text(const std::string& text, const std::string& source, const
     SceneJson raw;
     try {
         raw = SceneJson::parse(text);
-    } catch (const SceneJson::parse_error& e) {
+    } catch (const SceneJson::exception& e) {
         // nlohmann's message starts with "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
+        // (or out_of_range.406 "number overflow parsing '1e999'").
         std::string what = e.what();
         const auto bracket = what.find("] ");
         if (bracket != std::string::npos) what = what.substr(bracket + 2);

@@ -13,6 +13,7 @@ struct BackendInfo {
     bool compiled = false;
     bool available = false;     // compiled and a device is usable now
     std::string description;    // device found, or why not
+    bool prefers_neighbor_lists = false;  // what neighbors.lists "auto" means on this backend
 };
 BackendInfo openmp_backend_info();
 BackendInfo cuda_backend_info();

@@ -26,7 +26,11 @@ build_dir=${BUILD_DIR:-build}
 cuda=${MELTWATER_CUDA:-AUTO}
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-if [[ ! -f "$build_dir/CMakeCache.txt" ]]; then
+# Configure when there is no build yet, or when an existing one is not Release (a Debug build
+# left in the folder would make every figure the demo and the benchmarks print meaningless).
+build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build_dir/CMakeCache.txt" 2>/dev/null || true)
+if [[ ! -f "$build_dir/CMakeCache.txt" || "$build_type" != "Release" ]]; then
+  [[ -f "$build_dir/CMakeCache.txt" ]] && echo "setup: $build_dir was configured as '${build_type:-none}'; reconfiguring as Release"
   cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DMELTWATER_CUDA="$cuda" \
         ${CMAKE_CUDA_ARCHITECTURES:+-DCMAKE_CUDA_ARCHITECTURES="$CMAKE_CUDA_ARCHITECTURES"} >/dev/null
   echo "setup: configured $build_dir (Release, CUDA $cuda)"

@@ -59,6 +59,19 @@ std::int64_t device_memory_free() {
     return static_cast<std::int64_t>(free_bytes);
 }
 
+int multiprocessor_count() {
+    static const int count = [] {
+        int device = 0, sms = 0;
+        if (cudaGetDevice(&device) != cudaSuccess ||
+            cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device) != cudaSuccess) {
+            (void)cudaGetLastError();
+            return 1;
+        }
+        return sms;
+    }();
+    return count;
+}
+
 void synchronize() { check_cuda(cudaDeviceSynchronize(), "synchronize"); }
 
 void* cub_workspace(std::size_t bytes) {

@@ -43,6 +43,7 @@ int thread_count();
 bool backend_available();          // a CUDA device is present and usable
 std::string device_description();  // e.g. "NVIDIA H100 80GB HBM3 (sm_90, 79.1 GiB)"
 std::int64_t device_memory_free();
+int multiprocessor_count();  // of the current device, read once
 void synchronize();
 // Set MELTWATER_CUDA_SYNC=1 to synchronise and check after every launch (debug mode, as PBRT).
 bool debug_sync_enabled();
@@ -90,24 +91,30 @@ __global__ void parallel_for_kernel(std::size_t n, F f) {
     if (i < n) f(i);
 }
 
-// Block size chosen once per lambda type from the occupancy calculator.
+// Block size: the occupancy calculator's choice for the kernel, computed once per lambda type and
+// capped at 256 (it returns the largest block that reaches full occupancy, up to 1024, which
+// leaves most multiprocessors idle on small scenes); then halved, down to 64, until the launch has
+// at least two blocks per multiprocessor.
 template <class F>
-int block_size_for() {
-    static int block = [] {
+int block_size_for(std::size_t n) {
+    static const int largest = [] {
         int min_grid = 0, best = 256;
         if (cudaOccupancyMaxPotentialBlockSize(&min_grid, &best, parallel_for_kernel<F>, 0, 0) != cudaSuccess) {
             (void)cudaGetLastError();
             best = 256;
         }
-        return best;
+        return best < 256 ? best : 256;
     }();
+    const std::size_t enough_blocks = 2 * static_cast<std::size_t>(multiprocessor_count());
+    int block = largest;
+    while (block > 64 && (n + block - 1) / block < enough_blocks) block /= 2;
     return block;
 }
 
 template <class F>
 void parallel_for(const char* name, std::size_t n, F f) {
     if (n == 0) return;
-    const int block = block_size_for<F>();
+    const int block = block_size_for<F>(n);
     const std::size_t grid = (n + block - 1) / block;
     parallel_for_kernel<F><<<static_cast<unsigned>(grid), block>>>(n, f);
     check_launch(name);
@@ -146,21 +153,23 @@ T transform_reduce(const char* name, std::size_t n, T identity, Op op, F f) {
     return *host;
 }
 
+// Returns the total. The last input (read before the scan, which may work in place) and the last
+// output are copied into pinned memory on the stream, so the call costs one synchronisation.
 template <class T>
 T exclusive_scan(const char* name, View<const T> in, View<T> out) {
     const std::size_t n = in.size();
     if (n == 0) return T(0);
-    T last_in{};
-    check_cuda(cudaMemcpy(&last_in, in.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
+    T* ends = static_cast<T*>(pinned_scratch(2 * sizeof(T)));
+    check_cuda(cudaMemcpyAsync(&ends[0], in.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
     std::size_t temp_bytes = 0;
     check_cuda(cub::DeviceScan::ExclusiveSum(nullptr, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n)),
                name);
     void* temp = cub_workspace(temp_bytes);
     check_cuda(cub::DeviceScan::ExclusiveSum(temp, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n)),
                name);
-    T last_out{};
-    check_cuda(cudaMemcpy(&last_out, out.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
-    return last_out + last_in;
+    check_cuda(cudaMemcpyAsync(&ends[1], out.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
+    check_cuda(cudaStreamSynchronize(0), name);
+    return ends[0] + ends[1];
 }
 
 void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,

@@ -7,7 +7,8 @@ namespace mw {
 
 BackendInfo cuda_backend_info() {
     const bool available = cuda::backend_available();
-    return BackendInfo{"cuda", true, available, available ? cuda::device_description() : "compiled, but no CUDA device found"};
+    return BackendInfo{"cuda", true, available, available ? cuda::device_description() : "compiled, but no CUDA device found",
+                       cuda::kPrefersNeighborLists};
 }
 
 std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup) {

@@ -6,7 +6,7 @@
 namespace mw {
 
 BackendInfo openmp_backend_info() {
-    return BackendInfo{"openmp", true, true, openmp::device_description()};
+    return BackendInfo{"openmp", true, true, openmp::device_description(), openmp::kPrefersNeighborLists};
 }
 
 std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads) {

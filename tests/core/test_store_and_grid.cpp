@@ -69,25 +69,25 @@ namespace {
 struct Cloud {
     const std::vector<Vec3>* points;
     std::size_t kdtree_get_point_count() const { return points->size(); }
-    float kdtree_get_pt(std::size_t i, std::size_t d) const {
+    Real kdtree_get_pt(std::size_t i, std::size_t d) const {
         const Vec3& p = (*points)[i];
-        return float(d == 0 ? p.x : d == 1 ? p.y : p.z);
+        return d == 0 ? p.x : d == 1 ? p.y : p.z;
     }
     template <class B>
     bool kdtree_get_bbox(B&) const { return false; }
 };
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3>;
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<Real, Cloud>, Cloud, 3>;
 
 std::set<std::pair<std::uint32_t, std::uint32_t>> nanoflann_pairs(const std::vector<Vec3>& points, Real h) {
     Cloud cloud{&points};
     Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
     tree.buildIndex();
     std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
-    std::vector<std::pair<unsigned, float>> matches;
+    std::vector<std::pair<unsigned, Real>> matches;
     nanoflann::SearchParams params;
     for (std::size_t i = 0; i < points.size(); ++i) {
-        const float q[3] = {float(points[i].x), float(points[i].y), float(points[i].z)};
-        tree.radiusSearch(q, float(h * h), matches, params);
+        const Real q[3] = {points[i].x, points[i].y, points[i].z};
+        tree.radiusSearch(q, h * h, matches, params);
         for (const auto& m : matches)
             if (m.first != i) pairs.insert({std::uint32_t(i), std::uint32_t(m.first)});
     }

@@ -1,0 +1,98 @@
+// The backend primitives against plain sequential answers, written once and compiled for each
+// backend: tests/core (OpenMP) and tests/cuda_backend (CUDA, where a GPU is present).
+#pragma once
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "backend/backend.hpp"
+
+namespace mw::test {
+
+// A size that is no multiple of any block size, so partial blocks and tails are exercised.
+constexpr std::size_t kPrimitiveCount = 100003;
+
+inline std::vector<int> random_values(std::size_t n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::vector<int> values(n);
+    for (auto& v : values) v = int(rng() % 1000) - 500;
+    return values;
+}
+
+inline void check_reductions() {
+    const std::vector<int> values = random_values(kPrimitiveCount, 7);
+    DeviceArray<int> data;
+    data.upload(values);
+    const View<const int> d = data.cview();
+    const std::size_t n = values.size();
+    CHECK(transform_reduce("sum", n, 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
+          std::accumulate(values.begin(), values.end(), 0L));
+    CHECK(transform_reduce("min", n, 1 << 30, MinOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
+          *std::min_element(values.begin(), values.end()));
+    CHECK(transform_reduce("max", n, -(1 << 30), MaxOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
+          *std::max_element(values.begin(), values.end()));
+}
+
+inline void check_exclusive_scan() {
+    const std::vector<int> values = random_values(kPrimitiveCount, 11);
+    DeviceArray<int> data, scanned(values.size());
+    data.upload(values);
+    const int total = exclusive_scan("scan", data.cview(), scanned.view());
+    std::vector<int> expected(values.size());
+    std::exclusive_scan(values.begin(), values.end(), expected.begin(), 0);
+    CHECK(scanned.to_host() == expected);
+    CHECK(total == std::accumulate(values.begin(), values.end(), 0));
+    // In place, as the neighbour lists scan their row sizes.
+    const int total_in_place = exclusive_scan("scan in place", data.cview(), data.view());
+    CHECK(data.to_host() == expected);
+    CHECK(total_in_place == total);
+}
+
+inline void check_sort_pairs() {
+    const std::size_t n = kPrimitiveCount;
+    std::mt19937 rng(13);
+    std::vector<std::uint32_t> keys(n), order(n);
+    for (auto& k : keys) k = rng() % 5000;
+    std::iota(order.begin(), order.end(), 0u);
+    DeviceArray<std::uint32_t> k_in, k_out(n), v_in, v_out(n);
+    k_in.upload(keys);
+    v_in.upload(order);
+    sort_pairs("sort", k_in.cview(), k_out.view(), v_in.cview(), v_out.view(), 13);
+    // Radix sorts are stable: equal keys keep their input order, which the permutation relies on
+    // for reproducible runs.
+    std::vector<std::uint32_t> expected_order = order;
+    std::stable_sort(expected_order.begin(), expected_order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+    CHECK(v_out.to_host() == expected_order);
+    std::sort(keys.begin(), keys.end());
+    CHECK(k_out.to_host() == keys);
+}
+
+inline void check_atomics() {
+    // A histogram built by every index adding into a few bins at once.
+    const std::vector<int> values = random_values(kPrimitiveCount, 17);
+    const int bins = 7;
+    DeviceArray<int> data, counts(bins);
+    DeviceArray<float> sums(bins);
+    data.upload(values);
+    counts.fill(0);
+    sums.fill(0.f);
+    const View<const int> d = data.cview();
+    const View<int> c = counts.view();
+    const View<float> s = sums.view();
+    parallel_for("histogram", values.size(), [=] MW_HD(std::size_t i) {
+        const int bin = (d[i] + 500) % bins;
+        atomic_add(&c[bin], 1);
+        atomic_add(&s[bin], 1.0f);  // whole numbers stay exact in float up to 2^24
+    });
+    std::vector<int> expected(bins, 0);
+    for (int v : values) ++expected[(v + 500) % bins];
+    CHECK(counts.to_host() == expected);
+    const std::vector<float> float_sums = sums.to_host();
+    for (int b = 0; b < bins; ++b) CHECK(float_sums[b] == float(expected[b]));
+}
+
+}  // namespace mw::test

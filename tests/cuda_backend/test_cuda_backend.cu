@@ -1,0 +1,40 @@
+// The CUDA backend's primitives against plain sequential answers: the checks of
+// tests/core/backend_primitives.hpp compiled for the GPU. Built only with the CUDA backend; each
+// case skips with a message where no CUDA device is present (CI).
+#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+#include <doctest/doctest.h>
+
+#define MW_BACKEND_CUDA
+#include "../core/backend_primitives.hpp"
+
+// No `using namespace mw` here: the backend's inline namespace mw::cuda would clash with the CUDA
+// library's own ::cuda in the code nvcc generates.
+namespace {
+bool gpu_present() {
+    if (mw::backend_available()) return true;
+    MESSAGE("skipped: no CUDA device found");
+    return false;
+}
+}  // namespace
+
+TEST_CASE("CUDA reductions agree with sequential answers") {
+    if (gpu_present()) mw::test::check_reductions();
+}
+TEST_CASE("CUDA exclusive scan agrees with a sequential scan, also in place") {
+    if (gpu_present()) mw::test::check_exclusive_scan();
+}
+TEST_CASE("CUDA radix sort is a stable sort") {
+    if (gpu_present()) mw::test::check_sort_pairs();
+}
+TEST_CASE("CUDA atomics lose no update") {
+    if (gpu_present()) mw::test::check_atomics();
+}
+TEST_CASE("CUDA memory ledger follows allocations") {
+    if (!gpu_present()) return;
+    const auto before = mw::memory_ledger().current.load();
+    {
+        mw::DeviceArray<double> big(1000);
+        CHECK(mw::memory_ledger().current.load() - before >= std::int64_t(8000));
+    }
+    CHECK(mw::memory_ledger().current.load() == before);
+}
