@@ -2,11 +2,16 @@
 # `make bench`: runs every benchmark on every backend available and writes one report,
 # bench/results/DATE-DEVICE.md, with the date, the device and the commands that produced it.
 # Usage: bench/run_benchmarks.sh [BUILD_DIR] [extra bench_fluid options, e.g. --quick or --large]
+# BENCH_THREADS=N: OpenMP threads (default: all cores). BENCH_BACKENDS: the fluid blocks to run,
+# "openmp cuda" by default (CUDA only where a GPU is usable); BENCH_BACKENDS=cuda skips the OpenMP
+# fluid block (a GPU session, bench/gpu_session.sh) and fails when no GPU is usable.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
 shift || true
 threads=${BENCH_THREADS:-$(nproc)}
+backends=${BENCH_BACKENDS:-openmp cuda}
+want() { [[ " $backends " == *" $1 "* ]]; }
 date=$(date +%Y-%m-%d)
 gpu=$("$build/meltwater" backends --json 2>/dev/null | python3 -c 'import json,sys; b=json.load(sys.stdin); c=[x for x in b["backends"] if x["name"]=="cuda"]; print("cuda" if c and c[0]["available"] else "")' 2>/dev/null || true)
 if [[ -n "$gpu" ]]; then
@@ -14,18 +19,24 @@ if [[ -n "$gpu" ]]; then
 else
   device="cpu-${threads}threads"
 fi
+if [[ -n "${BENCH_BACKENDS:-}" ]] && want cuda && [[ -z "$gpu" ]]; then
+  echo "bench: BENCH_BACKENDS=$BENCH_BACKENDS but no usable CUDA device in $build" >&2
+  exit 3
+fi
 out="bench/results/${date}-${device}.md"
 mkdir -p bench/results
 {
   echo "# Benchmarks, ${date}, ${device}"
   echo
   echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
-  echo "Command: \`make bench\` (bench/run_benchmarks.sh $build $*), BENCH_THREADS=${threads}"
+  echo "Command: \`make bench\` (bench/run_benchmarks.sh $build $*), BENCH_THREADS=${threads}${BENCH_BACKENDS:+, BENCH_BACKENDS=$BENCH_BACKENDS}"
   echo
 } > "$out"
-echo "## Fluid, OpenMP (${threads} threads)" >> "$out"
-"$build/bench_fluid" --backend openmp --threads "$threads" --out "$out" "$@"
-if [[ -n "$gpu" ]]; then
+if want openmp; then
+  echo "## Fluid, OpenMP (${threads} threads)" >> "$out"
+  "$build/bench_fluid" --backend openmp --threads "$threads" --out "$out" "$@"
+fi
+if [[ -n "$gpu" ]] && want cuda; then
   echo "## Fluid, CUDA" >> "$out"
   "$build/bench_fluid" --backend cuda --large --out "$out" "$@"
 fi
