@@ -1,5 +1,5 @@
 // OpenMP backend: host memory, `omp parallel for`, deterministic chunked reductions and scans,
-// libstdc++'s parallel sort. The API is the same, name for name, as backend/cuda/backend_cuda.cuh.
+// a stable LSD radix sort. The API is the same, name for name, as backend/cuda/backend_cuda.cuh.
 #pragma once
 #include <omp.h>
 
@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
-#include <parallel/algorithm>
 #include <string>
 #include <utility>
 #include <vector>
@@ -144,10 +143,9 @@ T exclusive_scan(const char* /*name*/, View<const T> in, View<T> out) {
     return running;
 }
 
-// Sorts (key, value) pairs by key, stably. Only the low `key_bits` bits of the keys are used by
-// the GPU radix sort; here the full key is compared (same order for keys below 2^key_bits).
-// Values are particle indices, so packing key and value into one 64-bit word gives unique words
-// whose sorted order is the stable order, whatever the sort algorithm.
+// Sorts (key, value) pairs by key, stably (equal keys keep their input order), looking only at the
+// low `key_bits` bits of the keys, like the GPU radix sort. A parallel LSD radix sort whose output
+// does not depend on the thread count; its scratch persists across calls (see the .cpp).
 void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
                 View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
 
