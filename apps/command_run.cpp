@@ -72,8 +72,19 @@ int command_run(int argc, char** argv) {
     if (out_dir.empty()) throw InputError("--out: empty directory name");
 
     const SimulationSetup setup = build_setup(scene);
-    make_directories(out_dir);  // before the simulation is built: an unwritable --out fails at once
-    std::unique_ptr<Simulation> sim = create_simulation(setup, backend, threads);
+    // Before the simulation is built, so that an unwritable --out fails at once; a directory made
+    // here is removed again (if still empty) when the simulation cannot be built.
+    std::error_code exists_error;
+    const bool out_existed = std::filesystem::exists(out_dir, exists_error);
+    make_directories(out_dir);
+    std::unique_ptr<Simulation> sim;
+    try {
+        sim = create_simulation(setup, backend, threads);
+    } catch (...) {
+        std::error_code ignored;
+        if (!out_existed) std::filesystem::remove(out_dir, ignored);
+        throw;
+    }
 
     const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
     std::unique_ptr<FrameWriter> frames;

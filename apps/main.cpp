@@ -45,8 +45,8 @@ int main(int argc, char** argv) {
         return 4;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr,
-                     "meltwater: error: out of host memory (run 'meltwater info' on the scene for its memory "
-                     "estimate; a coarser fluid.spacing or a smaller scene needs less)\n");
+                     "meltwater: error: out of host memory (a coarser spacing or a smaller scene or mesh needs "
+                     "less; 'meltwater info SCENE' estimates what a scene needs)\n");
         return 3;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "meltwater: error: %s\n", e.what());

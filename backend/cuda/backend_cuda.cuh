@@ -91,10 +91,10 @@ __global__ void parallel_for_kernel(std::size_t n, F f) {
     if (i < n) f(i);
 }
 
-// Block size: the occupancy calculator's choice for the kernel, computed once per lambda type and
+// Block size: the occupancy calculator's choice for the kernel, computed once per lambda type,
 // capped at 256 (it returns the largest block that reaches full occupancy, up to 1024, which
-// leaves most multiprocessors idle on small scenes); then halved, down to 64, until the launch has
-// at least two blocks per multiprocessor.
+// leaves most multiprocessors idle on small scenes) and kept a whole number of warps; then halved,
+// down to 64 and in whole warps, until the launch has at least two blocks per multiprocessor.
 template <class F>
 int block_size_for(std::size_t n) {
     static const int largest = [] {
@@ -103,11 +103,15 @@ int block_size_for(std::size_t n) {
             (void)cudaGetLastError();
             best = 256;
         }
-        return best < 256 ? best : 256;
+        best = best < 256 ? best : 256;
+        return best < 64 ? best : best / 32 * 32;
     }();
     const std::size_t enough_blocks = 2 * static_cast<std::size_t>(multiprocessor_count());
     int block = largest;
-    while (block > 64 && (n + block - 1) / block < enough_blocks) block /= 2;
+    while (block > 64 && (n + block - 1) / block < enough_blocks) {
+        const int half = block / 2 / 32 * 32;
+        block = half > 64 ? half : 64;
+    }
     return block;
 }
 

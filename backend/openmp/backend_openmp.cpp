@@ -90,7 +90,9 @@ void sort_pairs(const char* /*name*/, View<const std::uint32_t> keys_in, View<st
         const std::uint32_t* src_values = values_in.data();
         for (int pass = 0; pass < passes; ++pass) {
             const int shift = pass * digit_bits;
-            const std::uint32_t mask = static_cast<std::uint32_t>(radix - 1);
+            // The last pass may be narrower: bits above key_bits are ignored, as CUB does.
+            const int width = std::min(digit_bits, bits - shift);
+            const std::uint32_t mask = static_cast<std::uint32_t>((std::uint64_t(1) << width) - 1);
             std::uint32_t* const dst_keys = key_buf[(passes - 1 - pass) & 1];
             std::uint32_t* const dst_values = value_buf[(passes - 1 - pass) & 1];
             std::fill(mine, mine + radix, std::size_t(0));

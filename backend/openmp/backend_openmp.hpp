@@ -145,7 +145,8 @@ T exclusive_scan(const char* /*name*/, View<const T> in, View<T> out) {
 
 // Sorts (key, value) pairs by key, stably (equal keys keep their input order), looking only at the
 // low `key_bits` bits of the keys, like the GPU radix sort. A parallel LSD radix sort whose output
-// does not depend on the thread count; its scratch persists across calls (see the .cpp).
+// does not depend on the thread count; its scratch persists across calls (see the .cpp). The
+// outputs must not alias the inputs (CUB's sort requires the same).
 void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
                 View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
 

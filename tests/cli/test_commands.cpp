@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "backend/config.hpp"
 #include "cli_helpers.hpp"
 
 using namespace cli_test;
@@ -63,7 +64,8 @@ TEST_CASE("bad input: scene keys and values") {
     check_rejected(run("info " + tiny() + " --set neighbors.cells_per_support=3"), {"neighbors.cells_per_support"});
     check_rejected(run("info " + tiny() + " --set neighbors.lists=maybe"), {"neighbors.lists", "maybe"});
     // Numbers the simulation's scalar type cannot hold, and JSON numbers no double holds.
-    check_rejected(run("info " + tiny() + " --set 'gravity=[0,1e39,0]'"), {"gravity[1]", "1e+39"});
+    constexpr bool float_build = sizeof(mw::Real) == 4;
+    if (float_build) check_rejected(run("info " + tiny() + " --set 'gravity=[0,1e39,0]'"), {"gravity[1]", "1e+39"});
     check_rejected(run("info " + tiny() + " --set solver.dt=1e-300"), {"solver.dt"});
     check_rejected(run("info " + tiny() + " --set fluid.spacing=1e999"), {"fluid.spacing", "1e999"});
     check_rejected(run("info " + scene_file("overflow.json", tiny_scene_text(R"("run": {"end_time": 1e999})"))),
@@ -242,7 +244,13 @@ TEST_CASE("a frame reads back with meshio") {
 
 TEST_CASE("guards: a blow-up stops the run naming the step, keeping frame 0 and a failed summary") {
     const std::string dir = out_dir("nan");
-    // An absurd rest density overflows the float pressure on the first step.
+    // An absurd rest density overflows the float density sum on the first step. No scene value
+    // was found that overflows double within a few steps (PCISPH is invariant to the scale of the
+    // density), so a double-precision build skips this case; the guard itself is the same code.
+    if (sizeof(mw::Real) != 4) {
+        MESSAGE("skipped in a double-precision build: no scene value blows it up within 5 steps");
+        return;
+    }
     const Result r = run("run " + tiny() + " --steps 5 --out " + dir + " --set fluid.rest_density=1e38");
     CAPTURE(r.err);
     REQUIRE(r.code == 4);

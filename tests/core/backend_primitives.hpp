@@ -67,8 +67,19 @@ inline void check_sort_pairs() {
     std::stable_sort(expected_order.begin(), expected_order.end(),
                      [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
     CHECK(v_out.to_host() == expected_order);
-    std::sort(keys.begin(), keys.end());
-    CHECK(k_out.to_host() == keys);
+    std::vector<std::uint32_t> sorted_keys = keys;
+    std::sort(sorted_keys.begin(), sorted_keys.end());
+    CHECK(k_out.to_host() == sorted_keys);
+
+    // Bits above key_bits are ignored (as CUB does): random high bits leave the order unchanged.
+    // 23 and 31 bits are the widths where the OpenMP sort's passes cover more bits than asked.
+    for (int key_bits : {13, 23, 31}) {
+        std::vector<std::uint32_t> noisy(n);
+        for (std::size_t i = 0; i < n; ++i) noisy[i] = keys[i] | (std::uint32_t(rng()) << key_bits);
+        k_in.upload(noisy);
+        sort_pairs("sort, noisy high bits", k_in.cview(), k_out.view(), v_in.cview(), v_out.view(), key_bits);
+        CHECK_MESSAGE(v_out.to_host() == expected_order, "key_bits " << key_bits);
+    }
 }
 
 inline void check_atomics() {
