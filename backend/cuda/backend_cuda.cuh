@@ -19,6 +19,9 @@
 #include "backend/reduce_ops.hpp"
 #include "backend/view.hpp"
 
+// The inline namespace is mw::cuda. A .cu file must not say `using namespace mw;` at global
+// scope: nvcc's generated code names the CUDA library's own ::cuda, which would then be ambiguous
+// (tests/cuda_backend qualifies its names instead).
 #define MW_BACKEND_BEGIN \
     namespace mw {       \
     inline namespace cuda {

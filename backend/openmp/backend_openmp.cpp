@@ -39,7 +39,10 @@ std::int64_t device_memory_free() {
 }
 
 // Stable LSD radix sort of (key, value) pairs on the low `key_bits` bits of the keys, as CUB's
-// DeviceRadixSort::SortPairs does on the GPU. Called every step by the neighbour grid, so:
+// DeviceRadixSort::SortPairs does on the GPU. Hand-written, against the project's preference for
+// libraries, because the ones at hand fall short here: GNU's parallel mergesort (used before)
+// allocates n-sized temporaries on every call, and TBB's parallel_sort runs on its own thread pool,
+// outside OpenMP and --threads. Called every step by the neighbour grid, so:
 //  * Scratch persists across calls and only grows: same-size or smaller calls allocate nothing.
 //  * Stability is by input position (never by value), and each thread owns a fixed contiguous
 //    chunk whose elements keep their order within every bucket, so the output is the one stable
