@@ -184,11 +184,10 @@ class NeighborGrid {
         // Z-order keys need 3 bits per level plus the group; beyond 1024 cells per axis, use linear.
         shape_.zorder = ordering == CellOrdering::kZOrder && bits <= 10;
         shape_.morton_bits = bits;
-        begin_.resize(2 * std::size_t(count));
         end_.resize(2 * std::size_t(count));
-        // Once: the linear-order gather reads the begin of empty cells too (then ignores it), and
-        // a value never written would be a read of uninitialised memory to compute-sanitizer.
-        begin_.fill(0);
+        // Filled once: the linear-order gather reads the begin of empty cells too (then ignores
+        // it), and a value never written would be a read of uninitialised memory to compute-sanitizer.
+        begin_.assign(2 * std::size_t(count), 0);
     }
     const GridShape& shape() const { return shape_; }
     bool uses_zorder() const { return shape_.zorder; }
@@ -277,8 +276,7 @@ inline void NeighborGrid::build_static(ParticleStore& store) {
     sorted_order_.resize(n);
     View<const Vec3> position{store.position.view().data() + first, n};
     View<std::uint32_t> keys = keys_.view(), order = order_.view();
-    group_first_.resize(kGroupCount);
-    group_first_.fill(0);
+    group_first_.assign(kGroupCount, 0);
     std::uint32_t* outside = group_first_.view().data();
     parallel_for("grid_static_keys", n, [=] MW_HD(std::size_t i) {
         int c[3] = {0, 0, 0};
@@ -299,10 +297,8 @@ inline void NeighborGrid::build_static(ParticleStore& store) {
     sort_pairs("grid_static_sort", keys_.cview(), sorted_keys_.view(), order_.cview(), sorted_order_.view(),
                shape.key_bits());
     store.permute(sorted_order_.cview(), first);
-    static_begin_.resize(shape.cell_count);
-    static_end_.resize(shape.cell_count);
-    static_begin_.fill(0);  // once per static build; see configure()
-    static_end_.fill(0);
+    static_begin_.assign(shape.cell_count, 0);  // once per static build; see configure()
+    static_end_.assign(shape.cell_count, 0);
     View<const std::uint8_t> type{store.type.view().data() + first, n};
     fill_cell_ranges(shape, position, type, false, n, first, static_begin_.view().data(), static_end_.view().data(),
                      nullptr);
@@ -336,8 +332,7 @@ inline GroupRanges NeighborGrid::build(ParticleStore& store) {
     // Only the ends are cleared: an empty cell has end 0, so [begin, end) is empty whatever stale
     // begin it holds, and every non-empty cell gets both written below.
     end_.fill(0);
-    group_first_.resize(kGroupCount);
-    group_first_.fill(static_cast<std::uint32_t>(n));
+    group_first_.assign(kGroupCount, static_cast<std::uint32_t>(n));
     fill_cell_ranges(shape, View<const Vec3>{position.data(), n}, View<const std::uint8_t>{type.data(), n}, true, n, 0,
                      begin_.view().data(), end_.view().data(), group_first_.view().data());
     std::uint32_t group_first[kGroupCount];

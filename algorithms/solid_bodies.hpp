@@ -77,10 +77,8 @@ class SolidBodies {
         pinned_.upload(L.ibp_pinned);
         regions_begin_.upload(L.ibp_regions_begin);
         regions_end_.upload(L.ibp_regions_end);
-        force_.resize(ibp_count_);
-        force_.fill(Vec3{0, 0, 0});
-        mean_rotation_.resize(ibp_count_);
-        mean_rotation_.fill(mat3_identity());
+        force_.assign(ibp_count_, Vec3{0, 0, 0});
+        mean_rotation_.assign(ibp_count_, mat3_identity());
         region_offsets_.upload(L.region_offsets);
         member_index_.upload(L.member_index);
         region_mass_.upload(L.region_mass);
@@ -89,17 +87,13 @@ class SolidBodies {
         region_inertia_inv_.upload(L.region_inertia_inv);
         region_object_.upload(L.region_object);
         const std::size_t regions = L.region_count();
-        rotation_.resize(regions);
-        rotation_.fill(quat_identity());
-        mean_displacement_.resize(regions);
-        mean_displacement_.fill(Vec3{0, 0, 0});
+        rotation_.assign(regions, quat_identity());
+        mean_displacement_.assign(regions, Vec3{0, 0, 0});
         bool any_damping = false;
         for (const auto& o : L.objects) any_damping = any_damping || o.damping_rate > 0;
         if (any_damping) {
-            region_velocity_.resize(regions);
-            region_omega_.resize(regions);
-            region_velocity_.fill(Vec3{0, 0, 0});
-            region_omega_.fill(Vec3{0, 0, 0});
+            region_velocity_.assign(regions, Vec3{0, 0, 0});
+            region_omega_.assign(regions, Vec3{0, 0, 0});
         }
         objects_.upload(L.objects);
         gp_rest_.upload(L.gp_rest);

@@ -87,6 +87,12 @@ class Section {
         out_ = SceneJson::object();
     }
 
+    // A number must lie in its range and fit the simulation's scalar type.
+    void check_value(const std::string& key_path, double value, const Range& range) const {
+        if (!range.contains(value)) fail(key_path, "must be " + range.describe() + ", got " + format_number(value));
+        if (!representable(value)) fail(key_path, format_number(value) + " is " + representable_range());
+    }
+
     [[noreturn]] void fail(const std::string& key_path, const std::string& what) const {
         throw InputError(source_ + ": " + (key_path.empty() ? std::string("scene") : key_path) + ": " + what);
     }
@@ -108,8 +114,7 @@ class Section {
         const SceneJson* v = find(key);
         if (!v && !fallback) fail(key_path(key), "required key is missing");
         const double value = v ? to_number(*v, key_path(key)) : *fallback;
-        if (!range.contains(value)) fail(key_path(key), "must be " + range.describe() + ", got " + format_number(value));
-        if (!representable(value)) fail(key_path(key), format_number(value) + " is " + representable_range());
+        check_value(key_path(key), value, range);
         out_[key] = value;
         return value;
     }
@@ -177,8 +182,7 @@ class Section {
             for (int a = 0; a < 3; ++a) {
                 const std::string p = key_path(key) + "[" + std::to_string(a) + "]";
                 c[a] = to_number((*v)[a], p);
-                if (!range.contains(c[a])) fail(p, "must be " + range.describe() + ", got " + format_number(c[a]));
-                if (!representable(c[a])) fail(p, format_number(c[a]) + " is " + representable_range());
+                check_value(p, c[a], range);
             }
         } else {
             c[0] = (*fallback)[0], c[1] = (*fallback)[1], c[2] = (*fallback)[2];

@@ -93,6 +93,11 @@ class BasicDeviceArray {
         if (n) Space::to_device(ptr_ + first, host, n * sizeof(T));
     }
     void fill(const T& value) { Space::fill(ptr_, size_, value); }
+    // resize(n), then every element set to value.
+    void assign(std::size_t n, const T& value) {
+        resize(n);
+        fill(value);
+    }
     void copy_from(const BasicDeviceArray& other) {
         resize(other.size_);
         if (size_) Space::within(ptr_, other.ptr_, size_ * sizeof(T));

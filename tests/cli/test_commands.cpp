@@ -84,6 +84,7 @@ TEST_CASE("bad input: command line") {
     check_rejected(run("run " + tiny() + " --time -1"), {"--time"});
     check_rejected(run("run " + tiny() + " --threads 0"), {"--threads"});
     check_rejected(run("run " + tiny() + " --backend vulkan"), {"--backend", "vulkan"});
+    check_rejected(run("info " + tiny() + " --backend vulkan"), {"--backend", "vulkan"});
     check_rejected(run("run " + tiny() + " " + tiny()), {"one scene"});
     check_rejected(run("run " + tiny() + " --set"), {"--set"});
     check_rejected(run("run " + tiny() + " --steps 1 --out /proc/meltwater_cannot_write"), {"/proc/meltwater_cannot_write"});
@@ -138,6 +139,17 @@ TEST_CASE("info: the built-in default scene and a small one") {
     const auto jv = nlohmann::json::parse(v.out);
     CHECK(jv["stages"].size() >= j["stages"].size());
     CHECK(jv["device_bytes"].get<long>() >= j["device_bytes"].get<long>());
+
+    // --backend picks the layout estimated: CUDA gathers from the grid (no neighbour lists), so
+    // it needs less than OpenMP's lists; no GPU is needed to estimate for one.
+    const Result c = run("info " + tiny() + " --json --backend cuda");
+    const Result o = run("info " + tiny() + " --json --backend openmp");
+    REQUIRE(c.code == 0);
+    REQUIRE(o.code == 0);
+    const auto jc = nlohmann::json::parse(c.out), jo = nlohmann::json::parse(o.out);
+    CHECK(jc["backend"] == "cuda");
+    CHECK(jo["backend"] == "openmp");
+    CHECK(jc["device_bytes"].get<long>() < jo["device_bytes"].get<long>());
 }
 
 TEST_CASE("run: two steps write frames, stats.csv and summary.json") {

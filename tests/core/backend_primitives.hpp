@@ -106,4 +106,13 @@ inline void check_atomics() {
     for (int b = 0; b < bins; ++b) CHECK(float_sums[b] == float(expected[b]));
 }
 
+inline void check_memory_ledger() {
+    const auto before = memory_ledger().current.load();
+    {
+        DeviceArray<double> big(1000);
+        CHECK(memory_ledger().current.load() - before >= std::int64_t(8000));
+    }
+    CHECK(memory_ledger().current.load() == before);
+}
+
 }  // namespace mw::test

@@ -106,10 +106,8 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> list_pairs(const NeighborListV
     return pairs;
 }
 
-std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<Vec3>& points, Vec3 lo, Vec3 hi, Real h,
-                                                            CellOrdering ordering, int cells_per_h,
-                                                            bool with_lists = false) {
-    ParticleStore store;
+// Fills `store` with one fluid particle per point, ids in point order, all moving.
+void load_fluid_points(ParticleStore& store, const std::vector<Vec3>& points) {
     const std::size_t n = points.size();
     store.resize(n, n);
     std::vector<std::uint32_t> id(n);
@@ -117,6 +115,14 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<V
     store.id.upload(id);
     store.position.upload(points);
     store.type.fill(kFluid);
+}
+
+std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<Vec3>& points, Vec3 lo, Vec3 hi, Real h,
+                                                            CellOrdering ordering, int cells_per_h,
+                                                            bool with_lists = false) {
+    ParticleStore store;
+    const std::size_t n = points.size();
+    load_fluid_points(store, points);
     NeighborGrid grid;
     grid.configure(lo, hi, h, ordering, cells_per_h);
     const GroupRanges ranges = grid.build(store);
@@ -181,12 +187,7 @@ TEST_CASE("neighbour lists stay exact when counts grow past their slack") {
     for (int i = 0; i < 5000; ++i) points.push_back({unit(rng), unit(rng) * Real(0.5), unit(rng) * Real(0.3)});
     const std::size_t n = points.size();
     ParticleStore store;
-    store.resize(n, n);
-    std::vector<std::uint32_t> id(n);
-    std::iota(id.begin(), id.end(), 0u);
-    store.id.upload(id);
-    store.position.upload(points);
-    store.type.fill(kFluid);
+    load_fluid_points(store, points);
     NeighborGrid grid;
     grid.configure({-h, -h, -h}, {1 + h, Real(0.5) + h, Real(0.3) + h}, h, CellOrdering::kZOrder);
     DeviceArray<std::uint32_t>& row_counts = store.add<std::uint32_t>("neighbor_count", FieldLife::kPersistent);
