@@ -1,6 +1,6 @@
 // The single entry point algorithms include. The build defines exactly one of MW_BACKEND_CUDA or
 // MW_BACKEND_OPENMP per translation unit; everything after this include is backend-agnostic.
-// Each backend lives in its own inline namespace (mw::cuda, mw::openmp) so that the same
+// Each backend lives in its own inline namespace (mw::cuda_backend, mw::openmp_backend) so that the same
 // algorithm headers compiled twice and linked into one program never share a symbol.
 #pragma once
 #if defined(MW_BACKEND_CUDA)

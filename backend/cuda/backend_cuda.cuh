@@ -19,12 +19,12 @@
 #include "backend/reduce_ops.hpp"
 #include "backend/view.hpp"
 
-// The inline namespace is mw::cuda. A .cu file must not say `using namespace mw;` at global
-// scope: nvcc's generated code names the CUDA library's own ::cuda, which would then be ambiguous
-// (tests/cuda_backend qualifies its names instead).
+// The inline namespace is mw::cuda_backend, not mw::cuda: with `using namespace mw;` at global
+// scope in a .cu file, a namespace named cuda would make nvcc's references to libcu++'s ::cuda
+// ambiguous.
 #define MW_BACKEND_BEGIN \
     namespace mw {       \
-    inline namespace cuda {
+    inline namespace cuda_backend {
 #define MW_BACKEND_END \
     }                  \
     }

@@ -6,15 +6,15 @@
 namespace mw {
 
 BackendInfo cuda_backend_info() {
-    const bool available = cuda::backend_available();
-    return BackendInfo{"cuda", true, available, available ? cuda::device_description() : "compiled, but no CUDA device found",
-                       cuda::kPrefersNeighborLists};
+    const bool available = cuda_backend::backend_available();
+    return BackendInfo{"cuda", true, available, available ? cuda_backend::device_description() : "compiled, but no CUDA device found",
+                       cuda_backend::kPrefersNeighborLists};
 }
 
 std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup) {
-    if (!cuda::backend_available()) throw DeviceError("the CUDA backend was requested but no CUDA device was found");
+    if (!cuda_backend::backend_available()) throw DeviceError("the CUDA backend was requested but no CUDA device was found");
     try {
-        return std::make_unique<cuda::BackendSimulation>(setup);
+        return std::make_unique<cuda_backend::BackendSimulation>(setup);
     } catch (const DeviceError& e) {
         // Out of memory while building: say how much a particle needs, measured on the CPU layout.
         throw DeviceError(std::string(e.what()) + "; the scene has " + std::to_string(setup.position.size()) +

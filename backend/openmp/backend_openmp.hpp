@@ -20,7 +20,7 @@
 
 #define MW_BACKEND_BEGIN \
     namespace mw {       \
-    inline namespace openmp {
+    inline namespace openmp_backend {
 #define MW_BACKEND_END \
     }                  \
     }

@@ -6,12 +6,12 @@
 namespace mw {
 
 BackendInfo openmp_backend_info() {
-    return BackendInfo{"openmp", true, true, openmp::device_description(), openmp::kPrefersNeighborLists};
+    return BackendInfo{"openmp", true, true, openmp_backend::device_description(), openmp_backend::kPrefersNeighborLists};
 }
 
 std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads) {
-    openmp::set_threads(threads);
-    return std::make_unique<openmp::BackendSimulation>(setup);
+    openmp_backend::set_threads(threads);
+    return std::make_unique<openmp_backend::BackendSimulation>(setup);
 }
 
 }  // namespace mw

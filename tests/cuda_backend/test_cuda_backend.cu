@@ -7,8 +7,6 @@
 #define MW_BACKEND_CUDA
 #include "../core/backend_primitives.hpp"
 
-// No `using namespace mw` here: the backend's inline namespace mw::cuda would clash with the CUDA
-// library's own ::cuda in the code nvcc generates.
 namespace {
 bool gpu_present() {
     if (mw::backend_available()) return true;

@@ -88,7 +88,7 @@ TEST_CASE("goals reproduce a rigid translation plus rotation of the rest shape")
         SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, Real(0.01), Vec3{0, 0, 0});
         add(s, box_mesh(Vec3{0.2f, 0.1f, 0.04f}, Vec3{0.5f, 0.5f, 0.5f}), solid(kind, 1000, 2, 1));
         const std::size_t n = s.position.size();
-        openmp::ParticleStore store;
+        openmp_backend::ParticleStore store;
         store.resize(n, n);
         std::vector<std::uint32_t> order(n);
         for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
@@ -96,7 +96,7 @@ TEST_CASE("goals reproduce a rigid translation plus rotation of the rest shape")
         store.type.upload(s.type);
         store.position.upload(s.position);
         store.velocity.upload(s.velocity);
-        openmp::SolidBodies bodies;
+        openmp_backend::SolidBodies bodies;
         bodies.init(s, order, store);
         // Move every particle rigidly: x = Q (x0 - p) + p + T.
         const Mat3 Q = rotation_about(Vec3{1, 2, 3}, 1.1);
