@@ -18,6 +18,13 @@
 
 MW_BACKEND_BEGIN
 
+// Sums over members of one region, relative to its anchor (see the top of the file): su = Σ m̃ (u
+// - u_a), Au = Σ m̃ (u - u_a) qᵀ and, for damped objects, sv = Σ m̃ v and sl = Σ m̃ (x - c0) × v.
+struct RegionSums {
+    Vec3 su, sv, sl;
+    Mat3 Au;
+};
+
 // Raw device pointers of the LSM state, captured by value in kernels.
 struct LsmData {
     // The particle store (positions and velocities of all particles) and the slot map.
@@ -44,6 +51,13 @@ struct LsmData {
     const SymMat3* region_A0 = nullptr;
     const SymMat3* region_inertia_inv = nullptr;
     const std::int32_t* region_object = nullptr;
+    // Chunked sums of large regions (lsm_regions.hpp, LsmHostLayout)
+    std::uint32_t chunk_count = 0;
+    const std::uint32_t* region_chunks = nullptr;
+    const std::uint32_t* chunk_begin = nullptr;
+    const std::uint32_t* chunk_end = nullptr;
+    const std::uint32_t* chunk_region = nullptr;
+    RegionSums* chunk_sums = nullptr;
     Quat* rotation = nullptr;
     Vec3* mean_displacement = nullptr;
     Vec3* region_velocity = nullptr;  // only written for objects with damping
@@ -57,50 +71,80 @@ struct LsmStepParams {
     Vec3 domain_min{0, 0, 0}, domain_max{0, 0, 0};
 };
 
+// Displacements are taken relative to one member's (the anchor's, the region's first): a
+// translation of the region then gives exactly zero sums, and ū exactly the translation.
+MW_INLINE Vec3 region_anchor_displacement(const LsmData& d, std::uint32_t r) {
+    const std::uint32_t anchor = d.member_index[d.region_offsets[r]];
+    return d.position[d.store_of_slot[anchor]] - d.rest[anchor];
+}
+
+MW_INLINE RegionSums sum_region_members(const LsmData& d, std::uint32_t begin, std::uint32_t end, Vec3 c0, Vec3 ua,
+                                        bool damp) {
+    RegionSums S{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, mat3_zero()};
+    for (std::uint32_t k = begin; k < end; ++k) {
+        const std::uint32_t s = d.member_index[k];
+        const std::uint32_t i = d.store_of_slot[s];
+        const Real m = d.split_mass[s];
+        const Vec3 x0 = d.rest[s];
+        const Vec3 x = d.position[i];
+        const Vec3 mu = m * ((x - x0) - ua);
+        const Vec3 q = x0 - c0;
+        S.su += mu;
+        S.Au.m[0][0] += mu.x * q.x, S.Au.m[0][1] += mu.x * q.y, S.Au.m[0][2] += mu.x * q.z;
+        S.Au.m[1][0] += mu.y * q.x, S.Au.m[1][1] += mu.y * q.y, S.Au.m[1][2] += mu.y * q.z;
+        S.Au.m[2][0] += mu.z * q.x, S.Au.m[2][1] += mu.z * q.y, S.Au.m[2][2] += mu.z * q.z;
+        if (damp) {
+            const Vec3 mv = m * d.velocity[i];
+            S.sv += mv;
+            S.sl += cross(x - c0, mv);
+        }
+    }
+    return S;
+}
+
+MW_INLINE bool region_damped(const LsmData& d, std::uint32_t r) {
+    return d.objects[d.region_object[r]].damping_rate > Real(0);
+}
+
 // Region sums, rotation (warm-started polar decomposition) and, for damped objects, the region's
 // rigid velocity (linear velocity V and angular velocity ω = I⁻¹ L, with the rest inertia
-// rotated by R).
+// rotated by R). A region of more than kRegionSerialMembers (a rigid body) would leave one thread
+// looping over all its members; it is summed in chunks first, in a fixed order (deterministic).
 inline void lsm_region_update(const LsmData d) {
+    parallel_for("lsm_region_chunks", d.chunk_count, [=] MW_HD(std::size_t c) {
+        const std::uint32_t r = d.chunk_region[c];
+        d.chunk_sums[c] = sum_region_members(d, d.chunk_begin[c], d.chunk_end[c], d.region_c0[r],
+                                             region_anchor_displacement(d, r), region_damped(d, r));
+    });
     parallel_for("lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
         const std::uint32_t begin = d.region_offsets[r], end = d.region_offsets[r + 1];
         if (begin == end) return;
         const Real M = d.region_mass[r];
         const Vec3 c0 = d.region_c0[r];
-        const bool damp = d.objects[d.region_object[r]].damping_rate > Real(0);
-        Vec3 su{0, 0, 0}, sv{0, 0, 0}, sl{0, 0, 0};
-        Mat3 Au = mat3_zero();
-        // Displacements are taken relative to one member's (the anchor's): a translation of the
-        // region then gives exactly zero sums, and ū exactly the translation.
-        const std::uint32_t anchor = d.member_index[begin];
-        const Vec3 ua = d.position[d.store_of_slot[anchor]] - d.rest[anchor];
-        for (std::uint32_t k = begin; k < end; ++k) {
-            const std::uint32_t s = d.member_index[k];
-            const std::uint32_t i = d.store_of_slot[s];
-            const Real m = d.split_mass[s];
-            const Vec3 x0 = d.rest[s];
-            const Vec3 x = d.position[i];
-            const Vec3 mu = m * ((x - x0) - ua);
-            const Vec3 q = x0 - c0;
-            su += mu;
-            Au.m[0][0] += mu.x * q.x, Au.m[0][1] += mu.x * q.y, Au.m[0][2] += mu.x * q.z;
-            Au.m[1][0] += mu.y * q.x, Au.m[1][1] += mu.y * q.y, Au.m[1][2] += mu.y * q.z;
-            Au.m[2][0] += mu.z * q.x, Au.m[2][1] += mu.z * q.y, Au.m[2][2] += mu.z * q.z;
-            if (damp) {
-                const Vec3 mv = m * d.velocity[i];
-                sv += mv;
-                sl += cross(x - c0, mv);
+        const bool damp = region_damped(d, std::uint32_t(r));
+        const Vec3 ua = region_anchor_displacement(d, std::uint32_t(r));
+        const std::uint32_t chunks_begin = d.region_chunks[r], chunks_end = d.region_chunks[r + 1];
+        RegionSums S;
+        if (chunks_begin == chunks_end) {
+            S = sum_region_members(d, begin, end, c0, ua, damp);
+        } else {
+            S = d.chunk_sums[chunks_begin];
+            for (std::uint32_t c = chunks_begin + 1; c < chunks_end; ++c) {
+                const RegionSums& part = d.chunk_sums[c];
+                S.su += part.su, S.sv += part.sv, S.sl += part.sl;
+                S.Au = S.Au + part.Au;
             }
         }
-        const Mat3 A = sym_to_mat3(d.region_A0[r]) + Au;
+        const Mat3 A = sym_to_mat3(d.region_A0[r]) + S.Au;
         const Quat R = polar_rotation(A, d.rotation[r]);
         d.rotation[r] = R;
-        const Vec3 ubar = ua + su / M;
+        const Vec3 ubar = ua + S.su / M;
         d.mean_displacement[r] = ubar;
         if (damp) {
             // L about c = c0 + ū: Σ m (x - c) × v = Σ m (x - c0) × v - ū × Σ m v.
-            const Vec3 L = sl - cross(ubar, sv);
+            const Vec3 L = S.sl - cross(ubar, S.sv);
             const Quat Rinv{R.w, -R.x, -R.y, -R.z};
-            d.region_velocity[r] = sv / M;
+            d.region_velocity[r] = S.sv / M;
             d.region_omega[r] = quat_rotate(R, d.region_inertia_inv[r] * quat_rotate(Rinv, L));
         }
     });

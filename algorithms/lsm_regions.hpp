@@ -68,6 +68,11 @@ struct LsmHostLayout {
     std::vector<Vec3> region_c0;
     std::vector<SymMat3> region_A0, region_inertia_inv;
     std::vector<std::int32_t> region_object;
+    // Regions too large for one thread to sum (a rigid object's single region) are summed in
+    // chunks first, then the chunks' sums per region: chunk c covers member_index[chunk_begin[c]
+    // .. chunk_end[c]) of region chunk_region[c]; region r owns chunks region_chunks[r] ..
+    // region_chunks[r+1], none when it is summed in one piece.
+    std::vector<std::uint32_t> region_chunks, chunk_begin, chunk_end, chunk_region;
     // GPs: normalised weights of Eq. 19, links are IBP slots
     std::vector<Vec3> gp_rest;
     std::vector<std::uint32_t> gp_offsets, gp_links;
@@ -163,8 +168,32 @@ inline SymMat3 regularised_inverse(double xx, double yy, double zz, double xy, d
 
 }  // namespace lsm_detail
 
+// A region with more members than this is summed in chunks (see LsmHostLayout). Elastic regions
+// stay below it for w <= 3 ((2w+1)^3 = 343 members), so their sums keep one thread and one order.
+constexpr std::size_t kRegionSerialMembers = 512;
+
+namespace lsm_detail {
+// Chunks of about sqrt(n) members (at least 256): the chunk pass and the pass over a region's
+// chunk sums then both loop about sqrt(n) times, e.g. 196 chunks of 256 for a 50k-IBP body.
+inline void append_region_chunks(LsmHostLayout& L, std::uint32_t region, std::size_t serial_limit) {
+    const std::uint32_t begin = L.region_offsets[region], end = L.region_offsets[region + 1];
+    const std::size_t n = end - begin;
+    if (n > serial_limit) {
+        const std::size_t root = static_cast<std::size_t>(std::ceil(std::sqrt(double(n))));
+        const std::uint32_t size = static_cast<std::uint32_t>(std::max<std::size_t>(256, root));
+        for (std::uint32_t b = begin; b < end; b += std::min(size, end - b)) {
+            L.chunk_begin.push_back(b);
+            L.chunk_end.push_back(b + std::min(size, end - b));
+            L.chunk_region.push_back(region);
+        }
+    }
+    L.region_chunks[region + 1] = static_cast<std::uint32_t>(L.chunk_begin.size());
+}
+}  // namespace lsm_detail
+
 // Builds the slot arrays and regions of every moving solid (elastic or rigid) of `setup`.
-inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup) {
+// `serial_limit`: regions with more members are summed in chunks (a parameter for tests).
+inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t serial_limit = kRegionSerialMembers) {
     LsmHostLayout L;
     const std::size_t n_particles = setup.position.size();
     auto check_index = [&](std::uint32_t i, const std::string& what, const std::string& name) {
@@ -259,6 +288,8 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup) {
         throw InputError("too many LSM region members (more than 2^32); use a smaller region half-width w");
     L.member_index.reserve(L.region_offsets[n_regions] + L.ibp_count);
     for (auto& m : region_members) L.member_index.insert(L.member_index.end(), m.begin(), m.end());
+    L.region_chunks.assign(n_regions + 1, 0);
+    for (std::size_t r = 0; r < n_regions; ++r) lsm_detail::append_region_chunks(L, std::uint32_t(r), serial_limit);
     for (std::size_t s = 0; s < L.ibp_count; ++s) L.ibp_split_mass[s] = L.ibp_mass[s] / Real(regions_of_count[s]);
     // Regions containing each IBP: its own region's members (elastic), or its object's region.
     for (std::size_t s = 0; s < L.ibp_count; ++s) {

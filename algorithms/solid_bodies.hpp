@@ -48,9 +48,11 @@ inline SolidSummary summarize_solids(const LsmData d) {
 class SolidBodies {
    public:
     // Registers the slot field in `store` (already sized and filled in the order `order`, the
-    // scene index of each store entry) and uploads the layout built from `setup`.
-    void init(const SimulationSetup& setup, const std::vector<std::uint32_t>& order, ParticleStore& store) {
-        LsmHostLayout L = build_lsm_layout(setup);
+    // scene index of each store entry) and uploads the layout built from `setup`. Regions of more
+    // than `serial_limit` members are summed in chunks (tests lower or raise it).
+    void init(const SimulationSetup& setup, const std::vector<std::uint32_t>& order, ParticleStore& store,
+              std::size_t serial_limit = kRegionSerialMembers) {
+        LsmHostLayout L = build_lsm_layout(setup, serial_limit);
         ibp_count_ = L.ibp_count;
         sbp_count_ = L.sbp_count;
         gp_count_ = L.gp_count;
@@ -86,6 +88,11 @@ class SolidBodies {
         region_A0_.upload(L.region_A0);
         region_inertia_inv_.upload(L.region_inertia_inv);
         region_object_.upload(L.region_object);
+        region_chunks_.upload(L.region_chunks);
+        chunk_begin_.upload(L.chunk_begin);
+        chunk_end_.upload(L.chunk_end);
+        chunk_region_.upload(L.chunk_region);
+        chunk_sums_.resize(L.chunk_begin.size());
         const std::size_t regions = L.region_count();
         rotation_.assign(regions, quat_identity());
         mean_displacement_.assign(regions, Vec3{0, 0, 0});
@@ -108,6 +115,7 @@ class SolidBodies {
     bool active() const { return ibp_count_ > 0; }
     std::size_t ibp_count() const { return ibp_count_; }
     std::size_t region_member_count() const { return members_total_; }
+    std::size_t region_chunk_count() const { return chunk_begin_.size(); }
 
     // After the neighbour sort: slot -> store index.
     void update_slot_map(const ParticleStore& store) {
@@ -156,6 +164,8 @@ class SolidBodies {
                pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() +
                mean_rotation_.bytes() + region_offsets_.bytes() + member_index_.bytes() + region_mass_.bytes() +
                region_c0_.bytes() + region_A0_.bytes() + region_inertia_inv_.bytes() + region_object_.bytes() +
+               region_chunks_.bytes() + chunk_begin_.bytes() + chunk_end_.bytes() + chunk_region_.bytes() +
+               chunk_sums_.bytes() +
                rotation_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes();
@@ -184,6 +194,12 @@ class SolidBodies {
         d.region_A0 = region_A0_.view().data();
         d.region_inertia_inv = region_inertia_inv_.view().data();
         d.region_object = region_object_.view().data();
+        d.chunk_count = static_cast<std::uint32_t>(chunk_begin_.size());
+        d.region_chunks = region_chunks_.view().data();
+        d.chunk_begin = chunk_begin_.view().data();
+        d.chunk_end = chunk_end_.view().data();
+        d.chunk_region = chunk_region_.view().data();
+        d.chunk_sums = chunk_sums_.view().data();
         d.rotation = rotation_.view().data();
         d.mean_displacement = mean_displacement_.view().data();
         d.region_velocity = region_velocity_.view().data();
@@ -228,6 +244,8 @@ class SolidBodies {
     DeviceArray<Vec3> region_c0_;
     DeviceArray<SymMat3> region_A0_, region_inertia_inv_;
     DeviceArray<std::int32_t> region_object_;
+    DeviceArray<std::uint32_t> region_chunks_, chunk_begin_, chunk_end_, chunk_region_;
+    DeviceArray<RegionSums> chunk_sums_;
     DeviceArray<Quat> rotation_;
     DeviceArray<Vec3> mean_displacement_, region_velocity_, region_omega_;
     DeviceArray<LsmObjectParams> objects_;

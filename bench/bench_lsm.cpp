@@ -1,5 +1,6 @@
-// LSM step time for elastic cubes of about 6k, 50k and 500k IBPs (w = 2) on each available
-// backend: median ms of the "lsm" stage (regions + polar, goals + update, GPs, SBPs, NaN guard).
+// LSM step time for elastic (w = 2) and rigid cubes of about 6k, 50k and 500k IBPs on each
+// available backend: median ms of the "lsm" stage (regions + polar, goals + update, GPs, SBPs, NaN
+// guard). A rigid cube is one region over all its IBPs, the case the chunked region sums are for.
 // Usage: bench_lsm [max_ibps=600000] [steps=20]
 #include <algorithm>
 #include <chrono>
@@ -24,42 +25,45 @@ int main(int argc, char** argv) {
     const double max_ibps = argc > 1 ? std::atof(argv[1]) : 600000;
     const int steps = argc > 2 ? std::atoi(argv[2]) : 20;
     const Real r0 = Real(0.02);
-    std::printf("| IBPs | SBPs | GPs | backend | device | ms_lsm (median of %d steps) | setup s |\n|---|---|---|---|---|---|---|\n", steps);
+    std::printf("| solid | IBPs | SBPs | GPs | backend | device | ms_lsm (median of %d steps) | setup s |\n|---|---|---|---|---|---|---|---|\n", steps);
     for (int side : {18, 37, 80}) {
         if (double(side) * side * side > max_ibps) break;
-        const auto t0 = std::chrono::steady_clock::now();
-        SimulationSetup s;
-        const Real L = side * r0;
-        s.params.domain_min = Vec3{0, 0, 0};
-        s.params.domain_max = Vec3{L + 0.2f, L + 0.2f, L + 0.2f};
-        s.params.fluid.spacing = r0;
-        s.params.fluid.support_radius = Real(0.05);
-        s.params.solver.dt = Real(0.005);
-        TriangleMesh mesh = make_box(Vec3d(L, L, L));
-        MeshTransform t;
-        t.translation = Vec3d(0.1 + L / 2, 0.1 + L / 2, 0.1 + L / 2);
-        apply_transform(mesh, t);
-        SolidSetup solid;
-        solid.name = "cube";
-        solid.stiffness = Real(0.5);
-        solid.region_half_width = 2;
-        add_solid_object(s, mesh, solid, Vec3{0, 0, 0}, 0, r0, 0.05);
-        const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const SolidSetup& o = s.solids[0];
-        std::vector<std::pair<std::string, bool>> backends{{"openmp", true}, {"cuda", cuda_backend_info().available}};
-        for (const auto& [name, ok] : backends) {
-            if (!ok) continue;
-            auto sim = name == "openmp" ? create_openmp_simulation(s, 0) : create_cuda_simulation(s);
-            const auto names = sim->stage_names();
-            const std::size_t lsm = std::find(names.begin(), names.end(), "lsm") - names.begin();
-            std::vector<double> ms;
-            for (int k = 0; k < steps + 3; ++k) {
-                sim->step();
-                if (k >= 3) ms.push_back(sim->last_report().stage_ms[lsm]);
+        for (SolidKind kind : {SolidKind::kElastic, SolidKind::kRigid}) {
+            const auto t0 = std::chrono::steady_clock::now();
+            SimulationSetup s;
+            const Real L = side * r0;
+            s.params.domain_min = Vec3{0, 0, 0};
+            s.params.domain_max = Vec3{L + 0.2f, L + 0.2f, L + 0.2f};
+            s.params.fluid.spacing = r0;
+            s.params.fluid.support_radius = Real(0.05);
+            s.params.solver.dt = Real(0.005);
+            TriangleMesh mesh = make_box(Vec3d(L, L, L));
+            MeshTransform t;
+            t.translation = Vec3d(0.1 + L / 2, 0.1 + L / 2, 0.1 + L / 2);
+            apply_transform(mesh, t);
+            SolidSetup solid;
+            solid.name = "cube";
+            solid.kind = kind;
+            solid.stiffness = Real(0.5);
+            solid.region_half_width = 2;
+            add_solid_object(s, mesh, solid, Vec3{0, 0, 0}, 0, r0, 0.05);
+            const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const SolidSetup& o = s.solids[0];
+            std::vector<std::pair<std::string, bool>> backends{{"openmp", true}, {"cuda", cuda_backend_info().available}};
+            for (const auto& [name, ok] : backends) {
+                if (!ok) continue;
+                auto sim = name == "openmp" ? create_openmp_simulation(s, 0) : create_cuda_simulation(s);
+                const auto names = sim->stage_names();
+                const std::size_t lsm = std::find(names.begin(), names.end(), "lsm") - names.begin();
+                std::vector<double> ms;
+                for (int k = 0; k < steps + 3; ++k) {
+                    sim->step();
+                    if (k >= 3) ms.push_back(sim->last_report().stage_ms[lsm]);
+                }
+                std::printf("| %s | %zu | %zu | %zu | %s | %s | %.3f | %.1f |\n", kind == SolidKind::kRigid ? "rigid" : "elastic", o.ibp.size(), o.sbp.size(), o.gp.size(), name.c_str(),
+                            sim->device_name().c_str(), median(ms), setup_s);
+                std::fflush(stdout);
             }
-            std::printf("| %zu | %zu | %zu | %s | %s | %.3f | %.1f |\n", o.ibp.size(), o.sbp.size(), o.gp.size(), name.c_str(),
-                        sim->device_name().c_str(), median(ms), setup_s);
-            std::fflush(stdout);
         }
     }
     return 0;
