@@ -41,7 +41,7 @@ if [[ -n "$gpu" ]] && want cuda; then
   "$build/bench_fluid" --backend cuda --large --out "$out" "$@"
 fi
 if [[ -x "$build/bench_lsm" ]]; then
-  echo "## LSM (elastic cubes, w = 2; every backend available)" >> "$out"
+  echo "## LSM (elastic cubes, w = 2, and rigid cubes; every backend available)" >> "$out"
   OMP_NUM_THREADS=$threads "$build/bench_lsm" >> "$out" || echo "bench_lsm failed" >> "$out"
 fi
 if [[ -x "$build/bench_sampling" ]]; then
