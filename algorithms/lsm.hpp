@@ -51,11 +51,10 @@ struct LsmData {
     const SymMat3* region_A0 = nullptr;
     const SymMat3* region_inertia_inv = nullptr;
     const std::int32_t* region_object = nullptr;
-    // Chunked sums of large regions (lsm_regions.hpp, LsmHostLayout)
+    // Chunked sums of large regions (lsm_regions.hpp, LsmHostLayout); chunk_count 0: none
     std::uint32_t chunk_count = 0;
     const std::uint32_t* region_chunks = nullptr;
     const std::uint32_t* chunk_begin = nullptr;
-    const std::uint32_t* chunk_end = nullptr;
     const std::uint32_t* chunk_region = nullptr;
     RegionSums* chunk_sums = nullptr;
     Quat* rotation = nullptr;
@@ -113,7 +112,8 @@ MW_INLINE bool region_damped(const LsmData& d, std::uint32_t r) {
 inline void lsm_region_update(const LsmData d) {
     parallel_for("lsm_region_chunks", d.chunk_count, [=] MW_HD(std::size_t c) {
         const std::uint32_t r = d.chunk_region[c];
-        d.chunk_sums[c] = sum_region_members(d, d.chunk_begin[c], d.chunk_end[c], d.region_c0[r],
+        const std::uint32_t end = c + 1 < d.region_chunks[r + 1] ? d.chunk_begin[c + 1] : d.region_offsets[r + 1];
+        d.chunk_sums[c] = sum_region_members(d, d.chunk_begin[c], end, d.region_c0[r],
                                              region_anchor_displacement(d, r), region_damped(d, r));
     });
     parallel_for("lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
@@ -123,7 +123,8 @@ inline void lsm_region_update(const LsmData d) {
         const Vec3 c0 = d.region_c0[r];
         const bool damp = region_damped(d, std::uint32_t(r));
         const Vec3 ua = region_anchor_displacement(d, std::uint32_t(r));
-        const std::uint32_t chunks_begin = d.region_chunks[r], chunks_end = d.region_chunks[r + 1];
+        const std::uint32_t chunks_begin = d.chunk_count ? d.region_chunks[r] : 0u;
+        const std::uint32_t chunks_end = d.chunk_count ? d.region_chunks[r + 1] : 0u;
         RegionSums S;
         if (chunks_begin == chunks_end) {
             S = sum_region_members(d, begin, end, c0, ua, damp);

@@ -69,10 +69,11 @@ struct LsmHostLayout {
     std::vector<SymMat3> region_A0, region_inertia_inv;
     std::vector<std::int32_t> region_object;
     // Regions too large for one thread to sum (a rigid object's single region) are summed in
-    // chunks first, then the chunks' sums per region: chunk c covers member_index[chunk_begin[c]
-    // .. chunk_end[c]) of region chunk_region[c]; region r owns chunks region_chunks[r] ..
-    // region_chunks[r+1], none when it is summed in one piece.
-    std::vector<std::uint32_t> region_chunks, chunk_begin, chunk_end, chunk_region;
+    // chunks first, then the chunks' sums per region. Region r owns chunks region_chunks[r] ..
+    // region_chunks[r+1] (none when it is summed in one piece); chunk c of region chunk_region[c]
+    // starts at member_index[chunk_begin[c]] and ends where the region's next chunk starts, or
+    // where the region ends. All empty when no region is chunked.
+    std::vector<std::uint32_t> region_chunks, chunk_begin, chunk_region;
     // GPs: normalised weights of Eq. 19, links are IBP slots
     std::vector<Vec3> gp_rest;
     std::vector<std::uint32_t> gp_offsets, gp_links;
@@ -183,7 +184,6 @@ inline void append_region_chunks(LsmHostLayout& L, std::uint32_t region, std::si
         const std::uint32_t size = static_cast<std::uint32_t>(std::max<std::size_t>(256, root));
         for (std::uint32_t b = begin; b < end; b += std::min(size, end - b)) {
             L.chunk_begin.push_back(b);
-            L.chunk_end.push_back(b + std::min(size, end - b));
             L.chunk_region.push_back(region);
         }
     }
@@ -290,6 +290,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
     for (auto& m : region_members) L.member_index.insert(L.member_index.end(), m.begin(), m.end());
     L.region_chunks.assign(n_regions + 1, 0);
     for (std::size_t r = 0; r < n_regions; ++r) lsm_detail::append_region_chunks(L, std::uint32_t(r), serial_limit);
+    if (L.chunk_begin.empty()) L.region_chunks.clear();  // nothing chunked: nothing stored or read per step
     for (std::size_t s = 0; s < L.ibp_count; ++s) L.ibp_split_mass[s] = L.ibp_mass[s] / Real(regions_of_count[s]);
     // Regions containing each IBP: its own region's members (elastic), or its object's region.
     for (std::size_t s = 0; s < L.ibp_count; ++s) {

@@ -90,7 +90,6 @@ class SolidBodies {
         region_object_.upload(L.region_object);
         region_chunks_.upload(L.region_chunks);
         chunk_begin_.upload(L.chunk_begin);
-        chunk_end_.upload(L.chunk_end);
         chunk_region_.upload(L.chunk_region);
         chunk_sums_.resize(L.chunk_begin.size());
         const std::size_t regions = L.region_count();
@@ -164,7 +163,7 @@ class SolidBodies {
                pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() +
                mean_rotation_.bytes() + region_offsets_.bytes() + member_index_.bytes() + region_mass_.bytes() +
                region_c0_.bytes() + region_A0_.bytes() + region_inertia_inv_.bytes() + region_object_.bytes() +
-               region_chunks_.bytes() + chunk_begin_.bytes() + chunk_end_.bytes() + chunk_region_.bytes() +
+               region_chunks_.bytes() + chunk_begin_.bytes() + chunk_region_.bytes() +
                chunk_sums_.bytes() +
                rotation_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
@@ -197,7 +196,6 @@ class SolidBodies {
         d.chunk_count = static_cast<std::uint32_t>(chunk_begin_.size());
         d.region_chunks = region_chunks_.view().data();
         d.chunk_begin = chunk_begin_.view().data();
-        d.chunk_end = chunk_end_.view().data();
         d.chunk_region = chunk_region_.view().data();
         d.chunk_sums = chunk_sums_.view().data();
         d.rotation = rotation_.view().data();
@@ -244,7 +242,7 @@ class SolidBodies {
     DeviceArray<Vec3> region_c0_;
     DeviceArray<SymMat3> region_A0_, region_inertia_inv_;
     DeviceArray<std::int32_t> region_object_;
-    DeviceArray<std::uint32_t> region_chunks_, chunk_begin_, chunk_end_, chunk_region_;
+    DeviceArray<std::uint32_t> region_chunks_, chunk_begin_, chunk_region_;
     DeviceArray<RegionSums> chunk_sums_;
     DeviceArray<Quat> rotation_;
     DeviceArray<Vec3> mean_displacement_, region_velocity_, region_omega_;
