@@ -177,7 +177,8 @@ class NeighborGrid {
         }
         if (count * kGroupCount >= (std::uint64_t(1) << 32))
             throw InputError("the domain is too large for its support radius: " + std::to_string(count) +
-                             " grid cells (at most about 1.4e9)");
+                             " grid cells (at most about 1.4e9); shrink the domain or enlarge the support radius "
+                             "(scene keys domain, fluid.support_radius)");
         shape_.cell_count = static_cast<std::uint32_t>(count);
         int bits = 0;
         while ((1 << bits) < largest) ++bits;

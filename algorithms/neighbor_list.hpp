@@ -14,7 +14,10 @@
 // a j out of range, without a branch: the PCISPH gathers ran twice as fast with branch-free terms
 // as with the same terms compiled into branches (docs/solver.md).
 #pragma once
+#include <string>
+
 #include "algorithms/neighbor_grid.hpp"
+#include "backend/errors.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -43,6 +46,16 @@ struct NeighborListView {
     }
 };
 
+// What one fill found, summed over the rows: rows that overflowed their slots, and the slots the
+// next layout will take (the exact counts plus slack), in 64 bits: the row offsets are 32-bit.
+struct ListFillSummary {
+    std::uint64_t overflowed_rows = 0;
+    std::uint64_t next_layout_slots = 0;
+    MW_INLINE ListFillSummary operator+(const ListFillSummary& o) const {
+        return {overflowed_rows + o.overflowed_rows, next_layout_slots + o.next_layout_slots};
+    }
+};
+
 class NeighborList {
    public:
     // Room per row beyond the last step's count: 64 bytes per fluid particle. A particle moving
@@ -63,18 +76,31 @@ class NeighborList {
     std::size_t bytes() const { return offsets_.bytes() + boundary_begin_.bytes() + indices_.bytes(); }
     long second_fills() const { return second_fills_; }  // builds that needed a second fill
 
+    // Offsets and slots are 32-bit (half the memory of 64-bit ones, and the lists already take
+    // most of a fluid particle's bytes); a layout past that limit is refused, never wrapped.
+    static void check_slots(std::uint64_t slots) {
+        if (slots > 0xffffffffull)
+            throw DeviceError("the neighbour lists would need " + std::to_string(slots) +
+                              " slots, more than their 32-bit offsets address (4294967295); run with "
+                              "--set neighbors.lists=off (grid gathers, no lists)");
+    }
+
     // The two steps of build(). Public only because nvcc allows no device lambda inside a
     // private member function.
     // Rows of row_counts[i] + kRowSlack slots. One small host copy (the total, to size indices).
     inline void lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts);
-    // Fills every row and records the exact counts; returns how many rows overflowed.
-    inline std::size_t fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
-                            View<std::uint32_t> row_counts);
+    // Fills every row and records the exact counts.
+    inline ListFillSummary fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position,
+                                Real radius, View<std::uint32_t> row_counts);
 
    private:
     DeviceArray<std::uint32_t> offsets_, boundary_begin_, indices_;
     const std::uint32_t* row_counts_ = nullptr;
     long second_fills_ = 0;
+    // Slots of the next layout, known from the last fill when the fluid count has not changed
+    // since; otherwise (the first build) summed once more from the counts.
+    std::uint64_t next_layout_slots_ = 0;
+    std::size_t last_fluid_count_ = std::size_t(-1);
 };
 
 inline void NeighborList::lay_out_rows(std::size_t fluid_count, View<const std::uint32_t> row_counts) {
@@ -91,7 +117,7 @@ inline void NeighborList::lay_out_rows(std::size_t fluid_count, View<const std::
     if (total > indices_.capacity()) indices_.resize(total + total / 4 + 1);
 }
 
-inline std::size_t NeighborList::fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position,
+inline ListFillSummary NeighborList::fill(const GridView& grid, std::size_t fluid_count, View<const Vec3> position,
                                       Real radius, View<std::uint32_t> row_counts) {
     const Real r2 = radius * radius;
     boundary_begin_.resize(fluid_count);
@@ -119,20 +145,33 @@ inline std::size_t NeighborList::fill(const GridView& grid, std::size_t fluid_co
         row_counts[i] = k - first;
     });
     View<const std::uint32_t> counts = row_counts;
-    return transform_reduce("neighbor_list_overflow", fluid_count, std::size_t(0), SumOp{}, [=] MW_HD(std::size_t i) {
-        return std::size_t(offsets[i] + counts[i] > offsets[i + 1]);
-    });
+    return transform_reduce("neighbor_list_overflow", fluid_count, ListFillSummary{}, SumOp{},
+                            [=] MW_HD(std::size_t i) {
+                                return ListFillSummary{std::uint64_t(offsets[i] + counts[i] > offsets[i + 1]),
+                                                       std::uint64_t(counts[i]) + kRowSlack};
+                            });
 }
 
 inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
                                 View<std::uint32_t> row_counts) {
     row_counts_ = row_counts.data();
+    if (fluid_count != last_fluid_count_) {
+        View<const std::uint32_t> counts = row_counts;
+        next_layout_slots_ = transform_reduce("neighbor_list_slots", fluid_count, std::uint64_t(0), SumOp{},
+                                              [=] MW_HD(std::size_t i) { return std::uint64_t(counts[i]) + kRowSlack; });
+        last_fluid_count_ = fluid_count;
+    }
+    check_slots(next_layout_slots_);
     lay_out_rows(fluid_count, row_counts);
-    if (fill(grid, fluid_count, position, radius, row_counts) == 0) return;
+    ListFillSummary filled = fill(grid, fluid_count, position, radius, row_counts);
+    next_layout_slots_ = filled.next_layout_slots;
+    if (filled.overflowed_rows == 0) return;
     // Some row overflowed: row_counts now holds every exact count, so the second fill fits.
     ++second_fills_;
+    check_slots(next_layout_slots_);
     lay_out_rows(fluid_count, row_counts);
-    fill(grid, fluid_count, position, radius, row_counts);
+    filled = fill(grid, fluid_count, position, radius, row_counts);
+    next_layout_slots_ = filled.next_layout_slots;
 }
 
 MW_BACKEND_END

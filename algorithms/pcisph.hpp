@@ -179,7 +179,8 @@ inline MotionSummary summarize_motion(std::size_t count, View<const Vec3> positi
     return transform_reduce("motion_summary", count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
         const Vec3 v = velocity[i];
         const Real v2 = norm2(v);
-        const bool finite = is_finite(v) && is_finite(position[i]);
+        // |v|² overflowing (speeds past ~1e19 m/s) would make the energy and the CFL step inf.
+        const bool finite = is_finite(v) && is_finite(position[i]) && std::isfinite(v2);
         return MotionSummary{finite ? 0.5 * double(mass) * double(v2) : 0.0, finite ? v2 : Real(0),
                              finite ? 0xffffffffu : static_cast<std::uint32_t>(i)};
     });

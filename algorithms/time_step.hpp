@@ -109,9 +109,12 @@ class BackendSimulation final : public Simulation {
     }
     void download(HostParticles& out) const override;
     ParticleCounts counts() const override { return counts_; }
+    // Everything this simulation holds on the device, and the backend's shared scratch (the
+    // sort's buffers, sized by the largest sort of the process so far).
     std::size_t device_bytes() const override {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
-               pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes();
+               pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
+               backend_scratch_bytes();
     }
     double time() const override { return time_; }
     std::string backend_name() const override { return kBackendName; }
@@ -159,7 +162,8 @@ class BackendSimulation final : public Simulation {
         const SolverParams& solver = params_.solver;
         if (solver.dt_mode == TimeStepMode::kFixed || last_max_speed_ <= 0) return solver.dt;
         const Real cfl_dt = solver.cfl_number * params_.fluid.spacing / static_cast<Real>(last_max_speed_);
-        return std::max(solver.dt_min, std::min(solver.dt, cfl_dt));
+        // The floor never lifts the step above the scene's largest step.
+        return std::max(std::min(solver.dt_min, solver.dt), std::min(solver.dt, cfl_dt));
     }
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
@@ -192,8 +196,8 @@ class BackendSimulation final : public Simulation {
         store_.velocity.download_range(&v, index, 1);
         char text[320];
         std::snprintf(text, sizeof text,
-                      "step %ld (t = %.6g s): %s %u became non-finite (position %g %g %g, velocity %g "
-                      "%g %g); try a smaller dt, or dt_mode \"cfl\"",
+                      "step %ld (t = %.6g s): %s %u became non-finite or its speed overflowed (position %g "
+                      "%g %g, velocity %g %g %g); try a smaller dt, or dt_mode \"cfl\"",
                       step_, time_, what, scene_index, double(x.x), double(x.y), double(x.z), double(v.x), double(v.y),
                       double(v.z));
         throw SimulationError(text);

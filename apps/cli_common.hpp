@@ -37,6 +37,12 @@ std::unique_ptr<Simulation> probe_on_host(SimulationSetup setup, const std::stri
 // re-thrown with the particle count and the memory estimate.
 std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, const std::string& backend, int threads);
 
+// Refuses (DeviceError, before anything is allocated) a scene whose host memory would exceed what
+// the machine has available (MemAvailable; no check where that cannot be read). `host_layout`:
+// the simulation runs on the host (openmp, or `info` measuring a layout there) rather than on a
+// GPU, where the host keeps only the initial particles and frame buffers.
+void check_host_memory(const Scene& scene, const std::string& backend, bool host_layout);
+
 std::string with_thousands(long n);
 std::string format_bytes(double bytes);
 std::string format_duration(double seconds);  // h:mm:ss or m:ss

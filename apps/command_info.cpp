@@ -1,4 +1,5 @@
 // `meltwater info [SCENE]`: what a run of the scene would create and run, without running it.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -25,14 +26,15 @@ int command_info(int argc, char** argv) {
         return 0;
     }
     const Scene scene = scene_from_options(args, overrides);
-    const SimulationSetup setup = build_setup(scene);
-    const ParticleCounts counts = count_particles(setup);
     // The estimate is measured on the host backend with the target backend's layout; a GPU need
     // not be present to estimate for one.
     const std::string requested = args["backend"].as<std::string>();
     if (requested != "auto" && requested != "cuda" && requested != "openmp")
         throw InputError("--backend: expected auto, cuda or openmp, got '" + requested + "'");
     const std::string backend = requested == "auto" ? choose_backend("auto") : requested;
+    check_host_memory(scene, backend, true);
+    const SimulationSetup setup = build_setup(scene);
+    const ParticleCounts counts = count_particles(setup);
     const std::unique_ptr<Simulation> probe = probe_on_host(setup, backend);
     const std::size_t bytes = probe->device_bytes();
     const std::vector<std::string> stages = probe->stage_names();
@@ -70,9 +72,12 @@ int command_info(int argc, char** argv) {
     for (std::size_t i = 0; i < stages.size(); ++i) std::printf("%s %s", i ? "," : "", stages[i].c_str());
     std::printf("\n");
     const FluidParams& f = scene.params.fluid;
-    std::printf("fluid       r0 %g m, h %g m, rest density %g kg/m3, viscosity %g Pa s%s\n", double(f.spacing),
-                double(f.support_radius), double(f.rest_density), double(f.viscosity),
-                f.viscosity > 0 ? "" : " (viscosity stage off)");
+    // Whether the viscosity stage runs is the simulation's decision (it also needs fluid, and wall
+    // friction needs walls), so it is read from the stage list rather than guessed from the keys.
+    const bool runs_viscosity = std::find(stages.begin(), stages.end(), "viscosity") != stages.end();
+    std::printf("fluid       r0 %g m, h %g m, rest density %g kg/m3, viscosity %g Pa s, wall viscosity %g Pa s%s\n",
+                double(f.spacing), double(f.support_radius), double(f.rest_density), double(f.viscosity),
+                double(f.wall_viscosity), runs_viscosity ? "" : " (viscosity stage off)");
     if (cfl)
         std::printf("solver      CFL time step (number %g, at most %g s), eta %g, %d..%d iterations\n",
                     double(solver.cfl_number), double(solver.dt), double(solver.eta), solver.min_iterations,

@@ -53,7 +53,9 @@ int command_run(int argc, char** argv) {
     int threads = 0;
     if (args.count("threads")) {
         threads = args["threads"].as<int>();
-        if (threads < 1) throw InputError("--threads must be at least 1, got " + std::to_string(threads));
+        // More threads than that is a typo, and libgomp crashes on tens of thousands.
+        if (threads < 1 || threads > 1024)
+            throw InputError("--threads must be in [1, 1024], got " + std::to_string(threads));
     }
     const bool quiet = args.count("quiet") > 0;
 
@@ -71,6 +73,7 @@ int command_run(int argc, char** argv) {
         args.count("out") ? args["out"].as<std::string>() : "results/" + (scene.name.empty() ? "run" : scene.name);
     if (out_dir.empty()) throw InputError("--out: empty directory name");
 
+    check_host_memory(scene, backend, backend == "openmp");
     const SimulationSetup setup = build_setup(scene);
     // Before the simulation is built, so that an unwritable --out fails at once; a directory made
     // here is removed again (if still empty) when the simulation cannot be built.
@@ -87,6 +90,7 @@ int command_run(int argc, char** argv) {
     }
 
     const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
+    remove_earlier_frames(out_dir);
     std::unique_ptr<FrameWriter> frames;
     if (scene.writes_vtu()) {
         frames = std::make_unique<FrameWriter>(out_dir);
@@ -126,8 +130,12 @@ int command_run(int argc, char** argv) {
         ++frame_index;
     };
 
+    // Ctrl-C, a terminal closing and a polite kill (a job scheduler's time limit) all stop the run
+    // after the current step, with whole stats.csv and summary.json and no partial frame.
     g_interrupted = 0;
-    auto previous_handler = std::signal(SIGINT, on_interrupt);
+    const int stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
+    void (*previous_handlers[3])(int);
+    for (int k = 0; k < 3; ++k) previous_handlers[k] = std::signal(stop_signals[k], on_interrupt);
     std::exception_ptr failure;
     bool interrupted = false;
     try {
@@ -144,6 +152,13 @@ int command_run(int argc, char** argv) {
             }
             try {
                 sim->step();
+            } catch (const DeviceError& e) {
+                // A step can still allocate (neighbour lists growing as the flow compresses):
+                // say where the run stood and what it held.
+                progress.finish();
+                throw DeviceError(std::string(e.what()) + " (in step " + std::to_string(steps_done + 1) + "; the " +
+                                  with_thousands(long(summary.particles.total())) + " particles held " +
+                                  format_bytes(double(summary.device_bytes)) + " before it)");
             } catch (...) {
                 progress.finish();
                 throw;
@@ -173,7 +188,7 @@ int command_run(int argc, char** argv) {
     } catch (...) {
         failure = std::current_exception();
     }
-    std::signal(SIGINT, previous_handler);
+    for (int k = 0; k < 3; ++k) std::signal(stop_signals[k], previous_handlers[k]);
 
     summary.wall_seconds = seconds_since(wall_start);
     summary.frames = frames ? frames->written() : 0;

@@ -10,6 +10,25 @@
 #include "backend/errors.hpp"
 
 namespace {
+// Messages quote what the user wrote (keys, names, paths); a control character in it must not
+// break the one-line message, nor send escape codes to the terminal.
+std::string one_line(const char* text) {
+    std::string out;
+    for (const char* c = text; *c; ++c) {
+        const unsigned char u = static_cast<unsigned char>(*c);
+        if (u >= 0x20 && u != 0x7f) {
+            out += *c;
+        } else if (u == '\n') {
+            out += "\\n";
+        } else {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", u);
+            out += escaped;
+        }
+    }
+    return out;
+}
+
 void print_usage() {
     std::printf(
         "usage: meltwater <command> [options]\n"
@@ -32,16 +51,17 @@ int main(int argc, char** argv) {
         if (command == "info") return mw::command_info(argc - 1, argv + 1);
         if (command == "backends") return mw::command_backends(argc - 1, argv + 1);
         if (command == "sample") return mw::command_sample(argc - 1, argv + 1);
-        std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample)\n", command.c_str());
+        std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample)\n",
+                     one_line(command.c_str()).c_str());
         return 2;
     } catch (const mw::InputError& e) {
-        std::fprintf(stderr, "meltwater: error: %s\n", e.what());
+        std::fprintf(stderr, "meltwater: error: %s\n", one_line(e.what()).c_str());
         return 2;
     } catch (const mw::DeviceError& e) {
-        std::fprintf(stderr, "meltwater: device error: %s\n", e.what());
+        std::fprintf(stderr, "meltwater: device error: %s\n", one_line(e.what()).c_str());
         return 3;
     } catch (const mw::SimulationError& e) {
-        std::fprintf(stderr, "meltwater: simulation failed: %s\n", e.what());
+        std::fprintf(stderr, "meltwater: simulation failed: %s\n", one_line(e.what()).c_str());
         return 4;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr,
@@ -49,7 +69,7 @@ int main(int argc, char** argv) {
                      "less; 'meltwater info SCENE' estimates what a scene needs)\n");
         return 3;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "meltwater: error: %s\n", e.what());
+        std::fprintf(stderr, "meltwater: error: %s\n", one_line(e.what()).c_str());
         return 1;
     }
 }

@@ -25,16 +25,32 @@ std::vector<float> to_floats(const std::vector<Real>& v) { return std::vector<fl
 SceneJson finite_or_null(double v) { return std::isfinite(v) ? SceneJson(v) : SceneJson(nullptr); }
 }  // namespace
 
-FrameWriter::FrameWriter(const std::string& out_dir) : frames_dir_(out_dir + "/frames") {
-    make_directories(frames_dir_);
-    // Frames of an earlier run into the same directory would mix with this run's: remove them.
+void remove_earlier_frames(const std::string& out_dir) {
+    const std::string frames_dir = out_dir + "/frames";
     std::error_code error;
-    for (const auto& entry : std::filesystem::directory_iterator(frames_dir_, error)) {
+    if (std::filesystem::is_directory(frames_dir, error)) {
+        for (const auto& entry : std::filesystem::directory_iterator(frames_dir, error)) {
+            const std::string name = entry.path().filename().string();
+            // A frame's temporary (NAME.tmp.PID) is left only by a run killed mid-write.
+            const std::size_t tmp = name.find(".tmp.");
+            const std::string frame_name = tmp == std::string::npos ? name : name.substr(0, tmp);
+            const std::string extension = std::filesystem::path(frame_name).extension().string();
+            if ((frame_name.rfind("particles_", 0) == 0 && extension == ".vtu") || frame_name == "particles.pvd" ||
+                (frame_name.rfind("object_", 0) == 0 && extension == ".obj"))
+                std::filesystem::remove(entry.path(), error);
+        }
+        std::filesystem::remove(frames_dir, error);  // only if now empty: a user's own files stay
+    }
+    // The same for temporaries of stats.csv and summary.json in DIR itself.
+    for (const auto& entry : std::filesystem::directory_iterator(out_dir, error)) {
         const std::string name = entry.path().filename().string();
-        if ((name.rfind("particles_", 0) == 0 && entry.path().extension() == ".vtu") || name == "particles.pvd" ||
-            (name.rfind("object_", 0) == 0 && entry.path().extension() == ".obj"))
+        if (name.rfind("stats.csv.tmp.", 0) == 0 || name.rfind("summary.json.tmp.", 0) == 0)
             std::filesystem::remove(entry.path(), error);
     }
+}
+
+FrameWriter::FrameWriter(const std::string& out_dir) : frames_dir_(out_dir + "/frames") {
+    make_directories(frames_dir_);
 }
 
 std::string FrameWriter::write(int index, const HostParticles& p, double time) {

@@ -13,10 +13,16 @@
 
 namespace mw {
 
+// Frames of an earlier run into the same directory would mix with this run's, or sit next to a
+// summary that says it wrote none: remove them (particles_*.vtu, particles.pvd, object_*.obj,
+// and the temporaries of a killed run), and frames/ itself when that leaves it empty. Run before
+// every run, with or without frames.
+void remove_earlier_frames(const std::string& out_dir);
+
 // Writes frames/particles_NNNNN.vtu (and the objects' meshes, once set_objects() was called).
 class FrameWriter {
    public:
-    explicit FrameWriter(const std::string& out_dir);  // creates frames/, removes stale particles_*.vtu, object_*.obj
+    explicit FrameWriter(const std::string& out_dir);  // creates frames/
     // The solid objects whose meshes go with every frame (static ones: their rest mesh).
     void set_objects(const std::vector<SolidSetup>& solids) { objects_ = solids; }
     // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView

@@ -1,5 +1,6 @@
 #include "apps/scene.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -77,6 +78,32 @@ std::string representable_range() {
            format_number(double(std::numeric_limits<Real>::max())) + ", or 0)";
 }
 
+// Edits (insert, delete, substitute, swap two neighbours) turning a into b: how a misspelt key
+// is recognised.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+    for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+    for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i)
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1])});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+        }
+    return d[a.size()][b.size()];
+}
+
+// A key of `object` that looks like a misspelling of `wanted` (and is not a key read already),
+// or "". Short keys allow one edit, longer ones two: "min" is not a misspelling of "max".
+std::string misspelling_of(const std::string& wanted, const SceneJson* object, const std::vector<std::string>& known) {
+    if (!object || !object->is_object()) return "";
+    for (auto it = object->begin(); it != object->end(); ++it) {
+        if (it.key() == wanted || std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
+        if (edit_distance(it.key(), wanted) <= (wanted.size() >= 6 ? 2u : 1u)) return it.key();
+    }
+    return "";
+}
+
 // One JSON object of the scene being read. Each getter validates one key, records its resolved
 // value in `out`, and marks the key as known; finish() rejects every key nobody asked for.
 class Section {
@@ -98,6 +125,22 @@ class Section {
     }
     std::string key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
+    // "required key is missing", with the key the user probably meant it to be, if any.
+    [[noreturn]] void missing(const std::string& key) const {
+        std::string hint = misspelling_hint(key);
+        // A whole section absent: its misspelt name sits in the parent.
+        if (hint.empty() && !in_ && parent_in_) {
+            const std::string near = misspelling_of(name_in_parent_, parent_in_, {});
+            if (!near.empty())
+                hint = " (there is no \"" + name_in_parent_ + "\"; is \"" + near + "\" a misspelling of it?)";
+        }
+        fail(key_path(key), "required key is missing" + hint);
+    }
+    std::string misspelling_hint(const std::string& key) const {
+        const std::string near = misspelling_of(key, in_, known_);
+        return near.empty() ? "" : " (is \"" + near + "\" a misspelling of it?)";
+    }
+
     const SceneJson* find(const std::string& key) {
         known_.push_back(key);
         if (!in_) return nullptr;
@@ -106,13 +149,13 @@ class Section {
     }
     const SceneJson& require(const std::string& key) {
         const SceneJson* v = find(key);
-        if (!v) fail(key_path(key), "required key is missing");
+        if (!v) missing(key);
         return *v;
     }
 
     double number(const std::string& key, std::optional<double> fallback, const Range& range) {
         const SceneJson* v = find(key);
-        if (!v && !fallback) fail(key_path(key), "required key is missing");
+        if (!v && !fallback) missing(key);
         const double value = v ? to_number(*v, key_path(key)) : *fallback;
         check_value(key_path(key), value, range);
         out_[key] = value;
@@ -173,7 +216,7 @@ class Section {
     // A 3-vector [x, y, z]; each component in `range`.
     Vec3 vec3(const std::string& key, std::optional<std::array<double, 3>> fallback, const Range& range = Range::any()) {
         const SceneJson* v = find(key);
-        if (!v && !fallback) fail(key_path(key), "required key is missing");
+        if (!v && !fallback) missing(key);
         double c[3];
         if (v) {
             if (!v->is_array() || v->size() != 3)
@@ -194,7 +237,10 @@ class Section {
     // A nested object (absent = every key at its default).
     Section object(const std::string& key) {
         const SceneJson* v = find(key);
-        return Section(v, key_path(key), out_[key], source_);
+        Section child(v, key_path(key), out_[key], source_);
+        child.parent_in_ = in_;
+        child.name_in_parent_ = key;
+        return child;
     }
 
     // An array of objects; calls read(section, index) for each element.
@@ -263,6 +309,8 @@ class Section {
     SceneJson& out_;
     const std::string& source_;
     std::vector<std::string> known_;
+    const SceneJson* parent_in_ = nullptr;  // the object holding this one (object() sets it)
+    std::string name_in_parent_;
 };
 
 Vec3 checked_box(Section& s, Vec3 lo, Vec3 hi) {
@@ -337,6 +385,12 @@ void read_neighbors(Section s, Scene& scene) {
     s.finish();
 }
 
+// Two boxes share volume (touching faces do not count).
+bool overlap(Vec3 lo_a, Vec3 hi_a, Vec3 lo_b, Vec3 hi_b) {
+    return lo_a.x < hi_b.x && lo_b.x < hi_a.x && lo_a.y < hi_b.y && lo_b.y < hi_a.y && lo_a.z < hi_b.z &&
+           lo_b.z < hi_a.z;
+}
+
 void read_fluid_blocks(Section& root, Scene& scene) {
     root.array_of_objects("fluid_blocks", [&](Section& s, int) {
         FluidBlock b;
@@ -345,6 +399,13 @@ void read_fluid_blocks(Section& root, Scene& scene) {
         b.velocity = s.vec3("velocity", std::array<double, 3>{0, 0, 0});
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the block must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
+        // Overlapping blocks would put two particles in one place: a density far above rest
+        // that PCISPH resolves by an explosion.
+        for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k)
+            if (overlap(b.min, b.max, scene.fluid_blocks[k].min, scene.fluid_blocks[k].max))
+                s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " +
+                                     describe_box(scene.fluid_blocks[k].min, scene.fluid_blocks[k].max) +
+                                     "; blocks may touch but not overlap");
         scene.fluid_blocks.push_back(b);
     });
 }
@@ -357,6 +418,12 @@ void read_static_boxes(Section& root, Scene& scene) {
         b.layers = s.integer("layers", scene.boundary_layers, 1, 8);
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the box must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
+        // Fluid inside a solid box would sit among its boundary particles and be blown out.
+        for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k)
+            if (overlap(b.min, b.max, scene.fluid_blocks[k].min, scene.fluid_blocks[k].max))
+                s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " +
+                                     describe_box(scene.fluid_blocks[k].min, scene.fluid_blocks[k].max) +
+                                     "; a static box may touch the fluid but not overlap it");
         scene.static_boxes.push_back(b);
     });
 }
@@ -445,10 +512,21 @@ void read_output(Section s, Scene& scene) {
 
 // "fluid_blocks[0].min" and "fluid_blocks.0.min" both give {fluid_blocks, 0, min}.
 std::vector<std::string> split_key_path(const std::string& key, const std::string& option) {
+    // a.b[2].c and a.b.2.c name the same key; a bracket must hold a bare index and close at once.
     std::string normalised;
-    for (char c : key) {
-        if (c == '[') normalised += '.';
-        else if (c != ']') normalised += c;
+    for (std::size_t i = 0; i < key.size(); ++i) {
+        if (key[i] == ']') throw InputError("--set " + option + ": malformed key path '" + key + "' (a stray ']')");
+        if (key[i] != '[') {
+            normalised += key[i];
+            continue;
+        }
+        const std::size_t close = key.find(']', i);
+        const std::string index = close == std::string::npos ? "" : key.substr(i + 1, close - i - 1);
+        if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos ||
+            (close + 1 < key.size() && key[close + 1] != '.' && key[close + 1] != '['))
+            throw InputError("--set " + option + ": malformed key path '" + key + "' (write [N] with an index N)");
+        normalised += '.' + index;
+        i = close;
     }
     std::vector<std::string> parts;
     std::stringstream ss(normalised);
@@ -546,10 +624,18 @@ std::string read_file(const std::string& path) {
     if (std::filesystem::is_directory(path, error)) throw InputError("scene file '" + path + "' is a directory");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError("cannot open scene file '" + path + "': " + std::strerror(errno));
-    std::stringstream ss;
-    ss << in.rdbuf();
+    // A scene is a few kilobytes; reading stops well past that (a device such as /dev/zero, or a
+    // mesh given by mistake, would otherwise be read until memory runs out).
+    constexpr std::size_t kMaxSceneBytes = 64u << 20;
+    std::string text;
+    char buffer[1 << 16];
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+        text.append(buffer, static_cast<std::size_t>(in.gcount()));
+        if (text.size() > kMaxSceneBytes)
+            throw InputError("scene file '" + path + "' is larger than 64 MiB: not a scene");
+    }
     if (in.bad()) throw InputError("cannot read scene file '" + path + "'");
-    return ss.str();
+    return text;
 }
 
 }  // namespace
@@ -568,10 +654,17 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     SceneJson out;
     Section root(&raw, "", out, source);
     scene.name = root.string("name", "");
+    // The name becomes the default output directory results/<name>: no path separators or dots
+    // that would lead elsewhere, nothing a shell or a terminal would mangle.
+    if (scene.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+        std::string::npos)
+        root.fail("name", "use letters, digits, '_' and '-' only (it names the output directory), got \"" +
+                              scene.name + "\"");
     root.string("description", "");
-    root.integer("dimensions", 3, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
-    if (out["dimensions"].get<int>() != 3)
-        root.fail("dimensions", "only 3 is supported for now, got " + std::to_string(out["dimensions"].get<int>()));
+    // 2D scenes are planned; until then any other value is refused.
+    if (const double d = root.number("dimensions", 3.0, Range::any()); d != 3)
+        root.fail("dimensions", "only 3 is supported for now, got " + format_number(d));
+    out["dimensions"] = 3;
     read_domain(root.object("domain"), scene);
     scene.params.gravity = root.vec3("gravity", std::array<double, 3>{0, -9.81, 0});
     read_fluid(root.object("fluid"), scene);
@@ -582,7 +675,8 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_static_boxes(root, scene);
     read_objects(root, scene);
     if (scene.fluid_blocks.empty() && scene.objects.empty())
-        root.fail("fluid_blocks", "at least one fluid block (or one object) is needed");
+        root.fail("fluid_blocks",
+                  "at least one fluid block (or one object) is needed" + root.misspelling_hint("fluid_blocks"));
     read_run(root.object("run"), scene);
     read_output(root.object("output"), scene);
     root.finish();
@@ -592,8 +686,38 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
 
 Scene parse_scene_text(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
     SceneJson raw;
+    // nlohmann keeps the last of two equal keys in an object; in a scene that is almost always an
+    // edit gone wrong, so it is refused, naming the key and where it is.
+    struct Container {
+        bool is_array;
+        std::string name;  // its key in the parent object, "[]" in a parent array, "" for the root
+        std::vector<std::string> keys;
+    };
+    std::vector<Container> open;
+    std::string last_key;
+    auto refuse_duplicates = [&](int /*depth*/, SceneJson::parse_event_t event, SceneJson& parsed) {
+        using Event = SceneJson::parse_event_t;
+        if (event == Event::object_start || event == Event::array_start) {
+            const std::string name = open.empty() ? "" : open.back().is_array ? "[]" : last_key;
+            open.push_back({event == Event::array_start, name, {}});
+        } else if (event == Event::object_end || event == Event::array_end) {
+            open.pop_back();
+        } else if (event == Event::key) {
+            last_key = parsed.get<std::string>();
+            std::vector<std::string>& keys = open.back().keys;
+            if (std::find(keys.begin(), keys.end(), last_key) != keys.end()) {
+                std::string path;
+                for (std::size_t k = 1; k < open.size(); ++k)
+                    path += (open[k].name == "[]" || path.empty() ? "" : ".") + open[k].name;
+                path += (path.empty() ? "" : ".") + last_key;
+                throw InputError(source + ": " + path + ": the key appears twice in its object");
+            }
+            keys.push_back(last_key);
+        }
+        return true;
+    };
     try {
-        raw = SceneJson::parse(text);
+        raw = SceneJson::parse(text, refuse_duplicates);
     } catch (const SceneJson::exception& e) {
         // nlohmann's message starts with "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
         // (or out_of_range.406 "number overflow parsing '1e999'").
@@ -633,6 +757,18 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
     if (path.empty()) return parse_scene_text(default_scene_text(), "built-in default scene", overrides);
     Scene scene = parse_scene_text(read_file(path), path, overrides);
     scene.base_dir = std::filesystem::path(path).parent_path().string();
+    // Mesh files are relative to the scene file's folder. The resolved scene (written into
+    // summary.json) names them absolutely, so that it reproduces the run wherever it is saved.
+    for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+        std::string& file = scene.objects[k].mesh_file;
+        if (file.empty() || std::filesystem::path(file).is_absolute()) continue;
+        std::error_code error;
+        const std::filesystem::path absolute =
+            std::filesystem::absolute(std::filesystem::path(scene.base_dir) / file, error).lexically_normal();
+        if (error) continue;  // left relative; the mesh loader names the file if it cannot be read
+        file = absolute.string();
+        scene.resolved["objects"][k]["mesh"]["file"] = file;
+    }
     return scene;
 }
 

@@ -1,6 +1,8 @@
 #include "apps/scene_builder.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "backend/errors.hpp"
@@ -33,12 +35,18 @@ void append(SimulationSetup& s, const std::vector<Vec3>& points, Vec3 velocity, 
 }
 }  // namespace
 
-long estimate_particle_count(const Scene& scene) {
+ParticleEstimate estimate_particles(const Scene& scene) {
     const double r0 = scene.params.fluid.spacing, rb = scene.boundary_spacing();
-    double n = 0;
-    for (const auto& b : scene.fluid_blocks) n += lattice_count(b.min, b.max, r0);
-    if (scene.walls) n += surface_count(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers);
-    for (const auto& b : scene.static_boxes) n += surface_count(b.min, b.max, rb, b.layers);
+    ParticleEstimate n;
+    for (const auto& b : scene.fluid_blocks) n.fluid += lattice_count(b.min, b.max, r0);
+    if (scene.walls)
+        n.boundary += surface_count(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers);
+    for (const auto& b : scene.static_boxes) n.boundary += surface_count(b.min, b.max, rb, b.layers);
+    return n;
+}
+
+long estimate_particle_count(const Scene& scene) {
+    const double n = estimate_particles(scene).total();
     return n > 1e18 ? static_cast<long>(1e18) : static_cast<long>(n);
 }
 
@@ -92,11 +100,38 @@ SimulationSetup build_setup(const Scene& scene) {
             pinned = [p, n](const Vec3& x) { return dot(x - p, n) < 0; };
         }
         const std::int32_t id = static_cast<std::int32_t>(scene.static_boxes.size() + k);
+        const std::string what = scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + ")";
         try {
-            add_solid_object(setup, object_mesh(scene, o), solid, o.velocity, id, scene.params.fluid.spacing,
-                             scene.params.fluid.support_radius, pinned);
+            const TriangleMesh mesh = object_mesh(scene, o);
+            // Fluid blocks and static boxes are checked against the domain when the scene is
+            // read; an object's extent is known only once its mesh is loaded and transformed.
+            // Outside the domain its particles would be clamped onto the walls in the first step.
+            const Aabb box = bounding_box(mesh);
+            const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
+            if (box.lo.x() < lo.x || box.lo.y() < lo.y || box.lo.z() < lo.z || box.hi.x() > hi.x ||
+                box.hi.y() > hi.y || box.hi.z() > hi.z) {
+                char text[320];
+                std::snprintf(text, sizeof text,
+                              "the transformed mesh spans [%g, %g] x [%g, %g] x [%g, %g], not inside the domain "
+                              "[%g, %g] x [%g, %g] x [%g, %g] (see transform)",
+                              box.lo.x(), box.hi.x(), box.lo.y(), box.hi.y(), box.lo.z(), box.hi.z(), double(lo.x),
+                              double(hi.x), double(lo.y), double(hi.y), double(lo.z), double(hi.z));
+                throw InputError(text);
+            }
+            // Refused before sampling, which would allocate per lattice point: inner particles
+            // about volume / r0³, surface particles about area / r0², plus the mesh's vertices.
+            const double r0 = scene.params.fluid.spacing;
+            const double object_estimate = std::fabs(signed_volume(mesh)) / (r0 * r0 * r0) +
+                                           surface_area(mesh) / (r0 * r0) + double(mesh.vertex_count());
+            if (double(setup.position.size()) + object_estimate > double(kMaxSceneParticles))
+                throw InputError("the scene would create about " +
+                                 std::to_string(static_cast<long>(
+                                     std::min(1e18, double(setup.position.size()) + object_estimate))) +
+                                 " particles with this object (more than " + std::to_string(kMaxSceneParticles) +
+                                 "); increase fluid.spacing or scale the object down");
+            add_solid_object(setup, mesh, solid, o.velocity, id, r0, scene.params.fluid.support_radius, pinned);
         } catch (const InputError& e) {
-            throw InputError(scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + "): " + e.what());
+            throw InputError(what + ": " + e.what());
         }
         if (static_cast<long>(setup.position.size()) > kMaxSceneParticles)
             throw InputError(scene.source + ": the objects create more than " + std::to_string(kMaxSceneParticles) +

@@ -12,7 +12,13 @@ namespace mw {
 // Refuses (InputError) scenes that would create more than this many particles.
 constexpr long kMaxSceneParticles = 200'000'000;
 
-// A quick count of the particles build_setup() would create, without creating them.
+// A quick count of the particles build_setup() would create, without creating them (objects,
+// known only once sampled, are left out).
+struct ParticleEstimate {
+    double fluid = 0, boundary = 0;
+    double total() const { return fluid + boundary; }
+};
+ParticleEstimate estimate_particles(const Scene& scene);
 long estimate_particle_count(const Scene& scene);
 
 SimulationSetup build_setup(const Scene& scene);

@@ -22,8 +22,23 @@ static double median(std::vector<double> v) {
 }
 
 int main(int argc, char** argv) {
-    const double max_ibps = argc > 1 ? std::atof(argv[1]) : 600000;
-    const int steps = argc > 2 ? std::atoi(argv[2]) : 20;
+    const char* usage = "usage: bench_lsm [max_ibps=600000] [steps=20]\n";
+    if (argc > 3 || (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))) {
+        std::fprintf(argc > 3 ? stderr : stdout, "%s", usage);
+        return argc > 3 ? 2 : 0;
+    }
+    char* end = nullptr;
+    const double max_ibps = argc > 1 ? std::strtod(argv[1], &end) : 600000;
+    if (argc > 1 && (*end != '\0' || !(max_ibps > 0))) {
+        std::fprintf(stderr, "bench_lsm: max_ibps must be a positive number, got '%s'\n%s", argv[1], usage);
+        return 2;
+    }
+    const long steps_given = argc > 2 ? std::strtol(argv[2], &end, 10) : 20;
+    if (argc > 2 && (*end != '\0' || steps_given < 1 || steps_given > 100000)) {
+        std::fprintf(stderr, "bench_lsm: steps must be an integer in [1, 100000], got '%s'\n%s", argv[2], usage);
+        return 2;
+    }
+    const int steps = static_cast<int>(steps_given);
     const Real r0 = Real(0.02);
     std::printf("| solid | IBPs | SBPs | GPs | backend | device | ms_lsm (median of %d steps) | setup s |\n|---|---|---|---|---|---|---|---|\n", steps);
     for (int side : {18, 37, 80}) {

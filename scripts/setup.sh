@@ -28,10 +28,24 @@ generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 # Configure when there is no build yet, or when an existing one is not Release (a Debug build
 # left in the folder would make every figure the demo and the benchmarks print meaningless).
-build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build_dir/CMakeCache.txt" 2>/dev/null || true)
-if [[ ! -f "$build_dir/CMakeCache.txt" || "$build_type" != "Release" ]]; then
-  [[ -f "$build_dir/CMakeCache.txt" ]] && echo "setup: $build_dir was configured as '${build_type:-none}'; reconfiguring as Release"
-  cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DMELTWATER_CUDA="$cuda" \
+# Also when MELTWATER_CUDA or CMAKE_CUDA_ARCHITECTURES is given and differs from what the
+# existing build was configured with, so that the variables are never silently ignored.
+cached() { sed -n "s/^$1:[A-Z]*=//p" "$build_dir/CMakeCache.txt" 2>/dev/null || true; }
+build_type=$(cached CMAKE_BUILD_TYPE)
+reason=""
+if [[ -f "$build_dir/CMakeCache.txt" ]]; then
+  [[ "$build_type" != "Release" ]] && reason="it was configured as '${build_type:-none}'"
+  [[ -n "${MELTWATER_CUDA:-}" && "$MELTWATER_CUDA" != "$(cached MELTWATER_CUDA)" ]] &&
+    reason="MELTWATER_CUDA=$MELTWATER_CUDA differs from its '$(cached MELTWATER_CUDA)'"
+  [[ -n "${CMAKE_CUDA_ARCHITECTURES:-}" && "$CMAKE_CUDA_ARCHITECTURES" != "$(cached CMAKE_CUDA_ARCHITECTURES)" ]] &&
+    reason="CMAKE_CUDA_ARCHITECTURES=$CMAKE_CUDA_ARCHITECTURES differs from its '$(cached CMAKE_CUDA_ARCHITECTURES)'"
+fi
+if [[ ! -f "$build_dir/CMakeCache.txt" || -n "$reason" ]]; then
+  [[ -n "$reason" ]] && echo "setup: reconfiguring $build_dir: $reason"
+  # A reconfigured build keeps its CUDA choice unless MELTWATER_CUDA is given.
+  cuda_option=(-DMELTWATER_CUDA="$cuda")
+  [[ -f "$build_dir/CMakeCache.txt" && -z "${MELTWATER_CUDA:-}" ]] && cuda_option=() && cuda=$(cached MELTWATER_CUDA)
+  cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${cuda_option[@]}" \
         ${CMAKE_CUDA_ARCHITECTURES:+-DCMAKE_CUDA_ARCHITECTURES="$CMAKE_CUDA_ARCHITECTURES"} >/dev/null
   echo "setup: configured $build_dir (Release, CUDA $cuda)"
 fi

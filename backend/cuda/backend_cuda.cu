@@ -74,11 +74,20 @@ int multiprocessor_count() {
 
 void synchronize() { check_cuda(cudaDeviceSynchronize(), "synchronize"); }
 
-void* cub_workspace(std::size_t bytes) {
+namespace {
+DeviceArray<unsigned char>& cub_workspace_array() {
     static DeviceArray<unsigned char> workspace;
+    return workspace;
+}
+}  // namespace
+
+void* cub_workspace(std::size_t bytes) {
+    DeviceArray<unsigned char>& workspace = cub_workspace_array();
     if (bytes > workspace.size()) workspace.resize(bytes + bytes / 2);
     return workspace.view().data();
 }
+
+std::size_t backend_scratch_bytes() { return cub_workspace_array().bytes(); }
 
 void* pinned_scratch(std::size_t bytes) {
     static void* buffer = nullptr;

@@ -62,12 +62,15 @@ void* pinned_scratch(std::size_t bytes);
 struct CudaSpace {
     static void* allocate(std::size_t bytes) {
         void* p = nullptr;
-        if (cudaMalloc(&p, bytes) != cudaSuccess) {
+        const cudaError_t status = cudaMalloc(&p, bytes);
+        if (status == cudaErrorMemoryAllocation) {
             (void)cudaGetLastError();
             throw DeviceError("out of GPU memory allocating " + std::to_string(bytes) + " bytes (" +
                               std::to_string(memory_ledger().current.load()) + " bytes already held, " +
                               std::to_string(device_memory_free()) + " free)");
         }
+        // Anything else (often an error left by an earlier kernel) is not a memory shortage.
+        check_cuda(status, "allocating GPU memory");
         return p;
     }
     static void release(void* p) { cudaFree(p); }
@@ -181,6 +184,11 @@ T exclusive_scan(const char* name, View<const T> in, View<T> out) {
 
 void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
                 View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
+
+// Scratch the backend keeps between calls and that no DeviceArray owner counts: CUB's workspace,
+// shared by every sort, scan and reduction of the process (the radix sort's is the large one,
+// about 8 bytes per sorted item, held with half again as headroom). Grows, never shrinks.
+std::size_t backend_scratch_bytes();
 
 // Atomics are called from host/device lambdas; only the device path runs on this backend.
 #if defined(__CUDA_ARCH__)

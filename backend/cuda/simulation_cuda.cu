@@ -13,13 +13,8 @@ BackendInfo cuda_backend_info() {
 
 std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup) {
     if (!cuda_backend::backend_available()) throw DeviceError("the CUDA backend was requested but no CUDA device was found");
-    try {
-        return std::make_unique<cuda_backend::BackendSimulation>(setup);
-    } catch (const DeviceError& e) {
-        // Out of memory while building: say how much a particle needs, measured on the CPU layout.
-        throw DeviceError(std::string(e.what()) + "; the scene has " + std::to_string(setup.position.size()) +
-                          " particles (run 'meltwater info' for the memory estimate)");
-    }
+    // The command line adds the scene's particle count and memory estimate to a DeviceError.
+    return std::make_unique<cuda_backend::BackendSimulation>(setup);
 }
 
 }  // namespace mw

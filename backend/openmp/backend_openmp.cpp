@@ -54,7 +54,17 @@ struct RadixScratch {
     std::vector<std::uint32_t> keys, values;  // the ping-pong partner of keys_out / values_out
     std::vector<std::size_t> offsets;         // [thread][digit]: counts, then scatter positions
 };
+// Per calling thread, so concurrent callers are safe.
+RadixScratch& radix_scratch() {
+    static thread_local RadixScratch scratch;
+    return scratch;
+}
 }  // namespace
+
+std::size_t backend_scratch_bytes() {
+    const RadixScratch& s = radix_scratch();
+    return (s.keys.capacity() + s.values.capacity()) * sizeof(std::uint32_t) + s.offsets.capacity() * sizeof(std::size_t);
+}
 
 void sort_pairs(const char* /*name*/, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
                 View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits) {
@@ -70,7 +80,7 @@ void sort_pairs(const char* /*name*/, View<const std::uint32_t> keys_in, View<st
     constexpr std::size_t kParallelMin = 1 << 14;
     const int max_threads = n < kParallelMin ? 1 : omp_get_max_threads();
 
-    static thread_local RadixScratch scratch;  // per calling thread, so concurrent callers are safe
+    RadixScratch& scratch = radix_scratch();
     if (scratch.keys.size() < n) {
         scratch.keys.resize(n);
         scratch.values.resize(n);

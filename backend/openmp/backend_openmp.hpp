@@ -150,6 +150,10 @@ T exclusive_scan(const char* /*name*/, View<const T> in, View<T> out) {
 void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
                 View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
 
+// Scratch the backend keeps between calls and that no DeviceArray owner counts: the sort's
+// ping-pong buffers (8 bytes per sorted item) of the calling thread. Grows, never shrinks.
+std::size_t backend_scratch_bytes();
+
 MW_INLINE void atomic_add(int* address, int value) { __atomic_fetch_add(address, value, __ATOMIC_RELAXED); }
 MW_INLINE void atomic_add(unsigned* address, unsigned value) {
     __atomic_fetch_add(address, value, __ATOMIC_RELAXED);

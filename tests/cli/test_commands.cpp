@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "backend/config.hpp"
@@ -90,6 +91,35 @@ TEST_CASE("bad input: command line") {
     check_rejected(run("run " + tiny() + " --steps 1 --out /proc/meltwater_cannot_write"), {"/proc/meltwater_cannot_write"});
     // A directory that exists but cannot be written (even by root): refused before simulating.
     check_rejected(run("run " + tiny() + " --steps 1 --out /proc"), {"/proc", "cannot write"});
+    // cxxopts would silently keep the last of a repeated option.
+    check_rejected(run("run " + tiny() + " --steps 1 --out a --out b"), {"--out", "more than once"});
+    check_rejected(run("run " + tiny() + " --steps 1 --steps 2"), {"--steps", "more than once"});
+    // libgomp crashes on tens of thousands of threads.
+    check_rejected(run("run " + tiny() + " --steps 1 --threads 100000"), {"--threads", "1024"});
+    check_rejected(run("backends extra"), {"extra"});
+    // A control character in what the user wrote stays escaped: the message is still one line.
+    check_rejected(run("info " + tiny() + " --set 'name=\"a\\nb\"'"), {"name", "a\\nb"});
+    check_rejected(run("info /dev/zero"), {"/dev/zero", "64 MiB"});
+}
+
+TEST_CASE("bad input: a scene larger than the host's memory is refused before allocating") {
+    // About 171 million fluid particles (and 7 million wall particles), under the 200 million
+    // cap: some 72 GB. Where the machine has that much, the check would let it through and info
+    // would build it, so skip.
+    std::ifstream meminfo("/proc/meminfo");
+    std::string line;
+    double available_kib = 0;
+    while (std::getline(meminfo, line))
+        if (std::sscanf(line.c_str(), "MemAvailable: %lf kB", &available_kib) == 1) break;
+    if (available_kib == 0 || available_kib > 60e6) {
+        MESSAGE("MemAvailable unknown or above 60 GB: the host-memory refusal is not tested here");
+        return;
+    }
+    const std::string huge = "--set fluid.spacing=0.00036 --set 'fluid_blocks.0.max=[0.2,0.2,0.2]' --set fluid.support_radius=0.00072";
+    check_rejected(run("info " + tiny() + " " + huge), {"host memory", "available"}, 3);
+    const std::string dir = out_dir("huge");
+    check_rejected(run("run " + tiny() + " " + huge + " --out " + dir), {"host memory", "available"}, 3);
+    CHECK(!fs::exists(dir));
 }
 
 TEST_CASE("--backend cuda without a usable GPU is a clear error") {
@@ -152,6 +182,27 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(jc["device_bytes"].get<long>() < jo["device_bytes"].get<long>());
 }
 
+TEST_CASE("the resolved scene names mesh files absolutely, so it runs from anywhere") {
+    const std::string folder = scratch_dir() + "/mesh_scene";
+    fs::create_directories(folder + "/elsewhere");
+    // A 0.1 m cube, outward-facing triangles.
+    write_text(folder + "/cube.obj",
+               "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nv 0 0 0.1\nv 0.1 0 0.1\nv 0.1 0.1 0.1\nv 0 0.1 0.1\n"
+               "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\n"
+               "f 2 3 7\nf 2 7 6\n");
+    write_text(folder + "/scene.json", tiny_scene_text(R"("objects": [{"mesh": {"file": "cube.obj"},
+        "transform": {"translation": [0.1, 0.05, 0.05]}}])"));
+    const Result r = run("info " + folder + "/scene.json --json");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    const std::string file = j["scene"]["objects"][0]["mesh"]["file"];
+    CHECK(fs::path(file).is_absolute());
+    CHECK(fs::equivalent(file, folder + "/cube.obj"));
+    write_text(folder + "/elsewhere/resolved.json", j["scene"].dump(2));
+    CHECK(run("info " + folder + "/elsewhere/resolved.json").code == 0);
+}
+
 TEST_CASE("run: two steps write frames, stats.csv and summary.json") {
     const std::string dir = out_dir("two_steps");
     const Result r = run("run " + tiny() + " --steps 2 --threads 1 --out " + dir + " --set solver.eta=0.02");
@@ -208,6 +259,20 @@ TEST_CASE("run: frames every 1/fps of simulated time, none with formats []") {
     REQUIRE(n.code == 0);
     CHECK(!fs::exists(none + "/frames/particles_00000.vtu"));
     CHECK(fs::exists(none + "/summary.json"));
+
+    // A run without frames into the first run's directory removes its frames (and a killed run's
+    // temporaries), so that they do not sit next to a summary that says 0 frames; other files stay.
+    write_text(dir + "/frames/particles_00009.vtu.tmp.12345", "partial");
+    write_text(dir + "/stats.csv.tmp.12345", "partial");
+    write_text(dir + "/frames/notes.txt", "mine");
+    const Result again = run("run " + tiny() + " --steps 1 --quiet --out " + dir + " --set 'output.formats=[]'");
+    REQUIRE(again.code == 0);
+    CHECK(!fs::exists(dir + "/frames/particles_00000.vtu"));
+    CHECK(!fs::exists(dir + "/frames/particles.pvd"));
+    CHECK(!fs::exists(dir + "/frames/particles_00009.vtu.tmp.12345"));
+    CHECK(!fs::exists(dir + "/stats.csv.tmp.12345"));
+    CHECK(fs::exists(dir + "/frames/notes.txt"));
+    CHECK(read_json(dir + "/summary.json")["frames"] == 0);
 }
 
 TEST_CASE("run: plain progress lines when stderr is not a terminal") {
@@ -275,6 +340,19 @@ TEST_CASE("guards: a blow-up stops the run naming the step, keeping frame 0 and 
     CHECK(s["status"] == "failed");
     CHECK(s.contains("error"));
     CHECK(fs::exists(dir + "/stats.csv"));
+}
+
+TEST_CASE("guards: a speed whose square overflows stops the run as a failure") {
+    // Finite velocity components, |v|² past the scalar type's range: before the guard looked at
+    // |v|², the energy went to inf, the particles left the grid and the run 'completed'.
+    const std::string speed = sizeof(mw::Real) == 4 ? "1e20" : "1e160";
+    const std::string dir = out_dir("overflow");
+    const Result r = run("run " + tiny() + " --steps 3 --quiet --out " + dir + " --set 'fluid_blocks.0.velocity=[" +
+                         speed + ",0,0]'");
+    CAPTURE(r.err);
+    CHECK(r.code == 4);
+    CHECK(contains(r.err, "speed overflowed"));
+    CHECK(read_json(dir + "/summary.json")["status"] == "failed");
 }
 
 TEST_CASE("guards: particles leaving an open domain are counted and reported") {

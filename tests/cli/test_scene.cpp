@@ -157,6 +157,24 @@ TEST_CASE("bad scenes give one line naming the key") {
         {"--set bad index", tiny, {"fluid_blocks.3.min=[0,0,0]"}, {"fluid_blocks", "index"}},
         {"--set without =", tiny, {"solver.eta"}, {"--set solver.eta", "KEY=VALUE"}},
         {"--set into a value", tiny, {"solver.eta.x=1"}, {"--set solver.eta.x"}},
+        {"--set stray bracket", tiny, {"fluid_blocks[0]].min=[0,0,0]"}, {"malformed key path"}},
+        {"--set non-index bracket", tiny, {"fluid_blocks[x].min=[0,0,0]"}, {"malformed key path", "[N]"}},
+        // A misspelt key: the missing key is named, and so is the key that is probably it.
+        {"misspelt section", "{\"domian\": {\"min\": [0,0,0], \"max\": [1,1,1]}, \"fluid\": {\"spacing\": 0.02}}", {},
+         {"domain.min", "required", "\"domian\""}},
+        {"misspelt key", tiny, {"fluid={\"spaceing\": 0.02}"}, {"fluid.spacing", "\"spaceing\""}},
+        {"misspelt array",
+         "{\"domain\": {\"min\": [0,0,0], \"max\": [1,1,1]}, \"fluid\": {\"spacing\": 0.02}, \"fluid_block\": []}", {},
+         {"fluid_blocks", "at least one", "\"fluid_block\""}},
+        {"duplicate key", "{\"domain\": {\"min\": [0,0,0], \"max\": [1,1,1]}, \"fluid\": {\"spacing\": 0.02, \"spacing\": -1}}",
+         {}, {"test.json", "fluid.spacing", "twice"}},
+        {"duplicate key in an array element", tiny_scene_text("\"static_boxes\": [{\"min\": [0.1,0,0], \"min\": [0,0,0], \"max\": [0.2,0.1,0.1]}]"),
+         {}, {"static_boxes[].min", "twice"}},
+        {"overlapping fluid blocks", tiny, {"fluid_blocks=[{\"min\":[0,0,0],\"max\":[0.1,0.1,0.1]},{\"min\":[0.05,0,0],\"max\":[0.15,0.1,0.1]}]"},
+         {"fluid_blocks[1]", "overlaps fluid_blocks[0]"}},
+        {"static box in the fluid", tiny, {"static_boxes=[{\"min\":[0.02,0,0.02],\"max\":[0.06,0.04,0.06]}]"},
+         {"static_boxes[0]", "overlaps fluid_blocks[0]"}},
+        {"a name that is a path", tiny, {"name=../../elsewhere"}, {"name", "letters, digits"}},
     };
     for (const Case& c : cases) {
         CAPTURE(c.what);
@@ -166,6 +184,12 @@ TEST_CASE("bad scenes give one line naming the key") {
         CHECK(message.find('\n') == std::string::npos);
         for (const auto& part : c.expect) CHECK(contains(message, part));
     }
+}
+
+TEST_CASE("touching fluid blocks and a box beside the fluid are accepted") {
+    CHECK(parse_error(tiny_scene_text(), {"fluid_blocks=[{\"min\":[0,0,0],\"max\":[0.1,0.1,0.1]},"
+                                          "{\"min\":[0.1,0,0],\"max\":[0.2,0.1,0.1]}]",
+                                          "static_boxes=[{\"min\":[0,0,0.1],\"max\":[0.1,0.05,0.2]}]"}) == "");
 }
 
 TEST_CASE("a scene too large to build is refused before allocating") {

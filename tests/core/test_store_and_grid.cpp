@@ -235,3 +235,17 @@ TEST_CASE("particles outside the grid are set aside, not lost silently") {
     CHECK(ranges.solid_end == 2);
     CHECK(store.position.to_host()[2].x == 5.f);
 }
+
+TEST_CASE("neighbour lists refuse a layout their 32-bit offsets cannot address") {
+    // Past 2^32 - 1 slots (about 80M fluid particles at 50 neighbours) the offsets would wrap and
+    // rows would overlap: the build must stop with a message instead.
+    CHECK_NOTHROW(NeighborList::check_slots(0xffffffffull));
+    CHECK_THROWS_AS(NeighborList::check_slots(0x100000000ull), DeviceError);
+    try {
+        NeighborList::check_slots(5000000000ull);
+    } catch (const DeviceError& e) {
+        const std::string message = e.what();
+        CHECK(message.find("5000000000") != std::string::npos);
+        CHECK(message.find("neighbors.lists=off") != std::string::npos);
+    }
+}
