@@ -38,7 +38,8 @@ inline SolidSummary summarize_solids(const LsmData d) {
             const std::uint32_t i = d.store_of_slot[s];
             const Vec3 v = d.velocity[i];
             const Real v2 = norm2(v);
-            const bool finite = is_finite(v) && is_finite(d.position[i]);
+            // As for fluid: |v|² overflowing counts as a blow-up.
+            const bool finite = is_finite(v) && is_finite(d.position[i]) && std::isfinite(v2);
             return MotionSummary{finite ? 0.5 * double(d.mass[s]) * double(v2) : 0.0, finite ? v2 : Real(0),
                                  finite ? 0xffffffffu : static_cast<std::uint32_t>(s)};
         });

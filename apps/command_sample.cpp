@@ -42,6 +42,64 @@ Vec3d parse_triple(const std::string& option, const std::string& text, bool allo
     return Vec3d(v[0], v[1], v[2]);
 }
 
+constexpr int kMaxThreads = 1024;
+
+// The --out directory for the lifetime of one `sample` call: created (with any missing parents)
+// and checked writable on construction. Unless keep() is called, the destructor undoes what the
+// call did: it removes the output files once any of them was written (a mix of new and earlier
+// files is no result) and the directories it created, so a failed call leaves no partial output.
+class OutputDirectory {
+public:
+    explicit OutputDirectory(const std::string& path) : path_(path) {
+        // The outermost missing directory: everything from there down is made by this call.
+        std::error_code error;
+        // Not normalised: "x/../y" makes x too. Each "p/.." comes before p in the list, so its
+        // removal meets p's parent while it still holds p, and leaves it alone.
+        std::filesystem::path full = std::filesystem::absolute(path_, error);
+        if (!full.has_filename()) full = full.parent_path();  // "out/" names the directory "out"
+        for (std::filesystem::path p = full; !error && !p.empty(); p = p.parent_path()) {
+            if (std::filesystem::exists(p, error) || error) break;
+            created_.push_back(p);
+            if (p == p.parent_path()) break;
+        }
+        try {
+            make_directories(path_);
+        } catch (...) {
+            remove_created();
+            throw;
+        }
+    }
+    OutputDirectory(const OutputDirectory&) = delete;
+    OutputDirectory& operator=(const OutputDirectory&) = delete;
+    ~OutputDirectory() {
+        if (kept_) return;
+        if (written_) {
+            std::error_code ignored;
+            for (const char* name : kFiles) std::filesystem::remove(path_of(name), ignored);
+        }
+        remove_created();
+    }
+    static constexpr const char* kFiles[] = {"sbp.vtu", "ibp.vtu", "gp.vtu"};
+    // Path of one of kFiles; asking for it means it is about to be written.
+    std::string file(const char* name) {
+        written_ = true;
+        return path_of(name);
+    }
+    void keep() { kept_ = true; }
+
+private:
+    std::string path_of(const char* name) const { return (std::filesystem::path(path_) / name).string(); }
+    void remove_created() const {
+        std::error_code ignored;
+        // Innermost first; remove() leaves a directory that is not empty alone.
+        for (const std::filesystem::path& p : created_) std::filesystem::remove(p, ignored);
+    }
+    std::string path_;
+    std::vector<std::filesystem::path> created_;  // innermost first
+    bool written_ = false;
+    bool kept_ = false;
+};
+
 std::vector<Vec3> to_vec3(const std::vector<Vec3d>& in) {
     std::vector<Vec3> out(in.size());
     for (std::size_t i = 0; i < in.size(); ++i)
@@ -72,7 +130,7 @@ int command_sample(int argc, char** argv) {
         ("translate", "translation x,y,z (applied last)", cxxopts::value<std::string>())
         ("directions", "ray line families for inside/outside: 0 auto (3 closed, 13 open), 3, 7 or 13",
          cxxopts::value<int>()->default_value("0"))
-        ("threads", "OpenMP threads (0: the default)", cxxopts::value<int>()->default_value("0"))
+        ("threads", "OpenMP threads, 1 to 1024 (default: OpenMP's, e.g. OMP_NUM_THREADS)", cxxopts::value<int>())
         ("no-coverage", "skip the coverage check")
         ("h,help", "show this help");
     options.parse_positional({"mesh"});
@@ -93,8 +151,27 @@ int command_sample(int argc, char** argv) {
     const int directions = args["directions"].as<int>();
     if (directions != 0 && directions != 3 && directions != 7 && directions != 13)
         throw InputError("--directions must be 0, 3, 7 or 13");
-    if (args["threads"].as<int>() > 0) omp_set_num_threads(args["threads"].as<int>());
+    if (args.count("threads")) {
+        // Each OpenMP thread reserves a stack; libgomp crashes when it cannot create the threads
+        // asked for (100000 of them), and no machine this runs on has more than 1024 cores.
+        const int threads = args["threads"].as<int>();
+        if (threads < 1 || threads > kMaxThreads)
+            throw InputError("--threads must be between 1 and " + std::to_string(kMaxThreads) + ", got " +
+                             std::to_string(threads));
+        omp_set_num_threads(threads);
+    }
+    // Start the thread team now: when the system cannot create the threads libgomp exits the
+    // process, and that had better happen before the output directory is made. (An empty region
+    // would be dropped by the compiler, hence the call.)
+    int team = 0;
+#pragma omp parallel
+    {
+#pragma omp single
+        team = omp_get_num_threads();
+    }
+    (void)team;
     const std::string out_dir = args["out"].as<std::string>();
+    if (out_dir.empty()) throw InputError("--out: empty directory name");
 
     const auto t_load = std::chrono::steady_clock::now();
     TriangleMesh mesh;
@@ -110,22 +187,29 @@ int command_sample(int argc, char** argv) {
     if (!transform.is_identity()) apply_transform(mesh, transform);
     const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
 
+    // The output directory is made (and checked writable) before sampling, which may take long,
+    // and removed again when this call made it and no complete output follows.
+    OutputDirectory output(out_dir);
     SampleOptions opt;
     opt.inside.directions = directions;
     opt.measure_coverage = !args.count("no-coverage");
     const SolidSample s = sample_solid(mesh, r0, h, opt);
     const SampleStats& st = s.stats;
+    if (s.ibp.count() == 0) {
+        std::ostringstream message;
+        message << mesh.source << ": the mesh holds no inner particle at spacing " << r0
+                << " (make it larger or decrease --spacing)";
+        throw InputError(message.str());
+    }
 
     const auto t_write = std::chrono::steady_clock::now();
-    make_directories(out_dir);
-    const std::filesystem::path dir(out_dir);
     {
         std::vector<VtuArray> arrays;
         arrays.push_back(VtuArray::uint8("type", std::vector<std::uint8_t>(s.sbp.count(), kSurfaceBoundary)));
         arrays.push_back(VtuArray::vector3("normal", to_vec3(s.sbp.normals)));
         arrays.push_back(VtuArray::int32("triangle", std::vector<std::int32_t>(s.sbp.triangles.begin(), s.sbp.triangles.end())));
         arrays.push_back(VtuArray::vector3("barycentric", to_vec3(s.sbp.barycentric)));
-        write_vtu((dir / "sbp.vtu").string(), to_vec3(s.sbp.positions), arrays);
+        write_vtu(output.file("sbp.vtu"), to_vec3(s.sbp.positions), arrays);
     }
     {
         std::vector<std::int32_t> lattice, neighbours;
@@ -137,7 +221,7 @@ int command_sample(int argc, char** argv) {
         arrays.push_back(VtuArray::uint8("type", std::vector<std::uint8_t>(s.ibp.count(), kInnerBoundary)));
         arrays.push_back(int32_components("lattice", 3, std::move(lattice)));
         arrays.push_back(VtuArray::int32("neighbours", std::move(neighbours)));
-        write_vtu((dir / "ibp.vtu").string(), to_vec3(s.ibp.positions), arrays);
+        write_vtu(output.file("ibp.vtu"), to_vec3(s.ibp.positions), arrays);
     }
     {
         std::vector<std::int32_t> links;
@@ -145,9 +229,10 @@ int command_sample(int argc, char** argv) {
         std::vector<VtuArray> arrays;
         arrays.push_back(VtuArray::uint8("type", std::vector<std::uint8_t>(s.gp.count(), kGeometry)));
         arrays.push_back(VtuArray::int32("ibp_links", std::move(links)));
-        write_vtu((dir / "gp.vtu").string(), to_vec3(s.gp.positions), arrays);
+        write_vtu(output.file("gp.vtu"), to_vec3(s.gp.positions), arrays);
     }
     const double write_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
+    output.keep();
 
     const double ratio = st.mesh_volume > 0 ? st.ibp_volume / st.mesh_volume : 0.0;
     std::printf("mesh        %s: %zu triangles, %s (%zu boundary edges)%s\n", mesh.source.c_str(), st.triangles,

@@ -1,5 +1,7 @@
 #include "sampling/geometry_links.hpp"
 
+#include "sampling/first_exception.hpp"
+
 #include <algorithm>
 
 #include "sampling/kdtree.hpp"
@@ -18,21 +20,27 @@ GeometryLinks link_geometry(const TriangleMesh& mesh, const std::vector<Vec3d>& 
     PointTree tree(ibp_positions);
     std::vector<std::vector<std::pair<std::uint32_t, double>>> found(static_cast<std::size_t>(n));
     std::size_t orphans = 0;
+    FirstException failure;  // the neighbour lists allocate: out of memory must reach the caller
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : orphans)
     for (long g = 0; g < n; ++g) {
-        auto& list = found[static_cast<std::size_t>(g)];
-        const Vec3d& x = mesh.vertices[static_cast<std::size_t>(g)];
-        tree.within(x, h, list);
-        // Keep only strictly positive weights (r < h), sorted by IBP index.
-        list.erase(std::remove_if(list.begin(), list.end(), [&](const auto& e) { return e.second >= h * h; }), list.end());
-        std::sort(list.begin(), list.end());
-        if (list.empty()) {
-            const auto nearest = tree.nearest(x);
-            list.push_back({static_cast<std::uint32_t>(nearest.first), -1.0});  // marker: weight 1
-            ++orphans;
-        }
-        out.offsets[static_cast<std::size_t>(g) + 1] = static_cast<int>(list.size());
+        bool orphan = false;
+        failure.run([&] {
+            auto& list = found[static_cast<std::size_t>(g)];
+            const Vec3d& x = mesh.vertices[static_cast<std::size_t>(g)];
+            tree.within(x, h, list);
+            // Keep only strictly positive weights (r < h), sorted by IBP index.
+            list.erase(std::remove_if(list.begin(), list.end(), [&](const auto& e) { return e.second >= h * h; }), list.end());
+            std::sort(list.begin(), list.end());
+            if (list.empty()) {
+                const auto nearest = tree.nearest(x);
+                list.push_back({static_cast<std::uint32_t>(nearest.first), -1.0});  // marker: weight 1
+                orphan = true;
+            }
+            out.offsets[static_cast<std::size_t>(g) + 1] = static_cast<int>(list.size());
+        });
+        orphans += orphan;
     }
+    failure.rethrow();
     out.without_ibp_in_h = orphans;
     for (long g = 0; g < n; ++g) out.offsets[static_cast<std::size_t>(g) + 1] += out.offsets[static_cast<std::size_t>(g)];
     out.ibp.resize(static_cast<std::size_t>(out.offsets.back()));

@@ -1,14 +1,20 @@
 #include "sampling/inside_outside.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <new>
+#include <sstream>
 #include <stdexcept>
 
 #include <embree3/rtcore.h>
 #include <omp.h>
 
+#include "backend/errors.hpp"
+#include "sampling/first_exception.hpp"
 #include "sampling/winding_number.hpp"
 
 namespace mw {
@@ -29,23 +35,44 @@ struct RawHit {
 struct HitCollector {
     RTCIntersectContext context;
     std::vector<RawHit>* hits;
+    // Embree catches whatever a filter throws and carries on with the ray, so a failed push_back
+    // would silently lose crossings: it is flagged here and raised by the caster instead.
+    bool out_of_memory;
 };
 
 void collect_all_hits(const RTCFilterFunctionNArguments* args) {
     HitCollector* collector = reinterpret_cast<HitCollector*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0) continue;
-        collector->hits->push_back({RTCRayN_tfar(args->ray, args->N, i), RTCHitN_primID(args->hit, args->N, i)});
         args->valid[i] = 0;  // reject, so traversal goes on and reports every hit
+        if (collector->out_of_memory) continue;
+        try {
+            collector->hits->push_back({RTCRayN_tfar(args->ray, args->N, i), RTCHitN_primID(args->hit, args->N, i)});
+        } catch (const std::bad_alloc&) {
+            collector->out_of_memory = true;
+        }
     }
 }
 
+// Largest distance from the mesh, in units of its bounding-box diagonal, at which a ray may start.
+// Coordinates are handed to Embree in those units, so this keeps every ray far inside the float
+// range (Embree asserts |origin| < 1.8e18) while allowing any line a caller can sensibly ask for.
+constexpr double kMaxRayStart = 1e6;
+
 // An Embree device and scene over one mesh. Vertices are stored as floats relative to the
-// bounding-box centre so that meshes far from the origin keep their precision.
+// bounding-box centre so that meshes far from the origin keep their precision, and divided by
+// a power of two close to the mesh's size: Embree's triangle test multiplies three coordinates
+// together in single precision, which overflows for meshes larger than about 1e12 and underflows
+// for ones smaller than about 1e-12 in their own units. A power of two scales every float
+// operation exactly, so meshes of ordinary size get bit-for-bit the crossings they had unscaled.
 class EmbreeScene {
 public:
     explicit EmbreeScene(const TriangleMesh& mesh) {
-        center_ = bounding_box(mesh).center();
+        const Aabb box = bounding_box(mesh);
+        center_ = box.center();
+        const double diagonal = box.extent().norm();
+        reach_ = diagonal > 0 && std::isfinite(diagonal) ? diagonal : 1.0;
+        unit_ = std::ldexp(1.0, std::ilogb(reach_));
         device_ = rtcNewDevice("verbose=0");
         if (!device_) throw std::runtime_error("Embree: cannot create a device");
         scene_ = rtcNewScene(device_);
@@ -55,7 +82,7 @@ public:
         float* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                                3 * sizeof(float), mesh.vertices.size()));
         for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-            const Vec3d p = mesh.vertices[i] - center_;
+            const Vec3d p = (mesh.vertices[i] - center_) / unit_;
             v[3 * i] = float(p.x());
             v[3 * i + 1] = float(p.y());
             v[3 * i + 2] = float(p.z());
@@ -75,8 +102,6 @@ public:
         }
         normals_.resize(mesh.triangles.size());
         for (std::size_t t = 0; t < mesh.triangles.size(); ++t) normals_[t] = triangle_normal(mesh, t);
-        const Vec3d e = bounding_box(mesh).extent();
-        reach_ = e.norm() + 1e-9;
     }
     ~EmbreeScene() { release(); }
     EmbreeScene(const EmbreeScene&) = delete;
@@ -90,7 +115,13 @@ public:
                    std::vector<Crossing>& out) const {
         hits.clear();
         out.clear();
-        const Vec3d org = through - center_ - back * dir;
+        const Vec3d org = (through - center_ - back * dir) / unit_;
+        if (!org.allFinite() || org.cwiseAbs().maxCoeff() > kMaxRayStart * reach_ / unit_) {
+            std::ostringstream s;
+            s << "inside/outside test: a ray would start " << (through - center_).norm() + back
+              << " from the centre of a mesh of size " << reach_ << ", beyond what the single-precision ray tracer handles";
+            throw InputError(s.str());
+        }
         RTCRayHit rh;
         rh.ray.org_x = float(org.x());
         rh.ray.org_y = float(org.y());
@@ -110,28 +141,36 @@ public:
         HitCollector collector;
         rtcInitIntersectContext(&collector.context);
         collector.hits = &hits;
+        collector.out_of_memory = false;
         rtcIntersect1(scene_, &collector.context, &rh);
+        if (collector.out_of_memory) throw std::bad_alloc();
+        // A hit at an infinite or NaN distance (the triangle test overflowed) locates nothing, and
+        // NaN would also break the ordering below: such hits are dropped.
+        hits.erase(std::remove_if(hits.begin(), hits.end(), [](const RawHit& h) { return !std::isfinite(h.t); }),
+                   hits.end());
         if (hits.empty()) return;
         // Order by t, then drop repeated reports of one triangle (a BVH may list it twice).
         std::sort(hits.begin(), hits.end(), [](const RawHit& a, const RawHit& b) {
             return a.t < b.t || (a.t == b.t && a.prim < b.prim);
         });
         const double eps = 1e-6 * reach_;
+        auto distance = [&](std::size_t k) { return double(hits[k].t) * unit_; };
+        auto sign_of = [&](std::size_t k) {
+            const double c = normals_[hits[k].prim].dot(dir);
+            return c > 0 ? 1 : (c < 0 ? -1 : 0);
+        };
         std::size_t i = 0;
         while (i < hits.size()) {
-            // Group hits within eps of the first: one crossing of an edge or vertex.
-            std::size_t j = i;
-            int sum = 0;
-            while (j < hits.size() && double(hits[j].t) - double(hits[i].t) <= eps) {
+            // Group hits within eps of the first: one crossing of an edge or vertex. The group
+            // always holds hits[i], so every pass consumes at least one hit.
+            int sum = sign_of(i);
+            std::size_t j = i + 1;
+            for (; j < hits.size() && distance(j) - distance(i) <= eps; ++j) {
                 bool repeated = false;
                 for (std::size_t k = i; k < j; ++k) repeated = repeated || hits[k].prim == hits[j].prim;
-                if (!repeated) {
-                    const double c = normals_[hits[j].prim].dot(dir);
-                    sum += c > 0 ? 1 : (c < 0 ? -1 : 0);
-                }
-                ++j;
+                if (!repeated) sum += sign_of(j);
             }
-            const double t = 0.5 * (double(hits[i].t) + double(hits[j - 1].t));
+            const double t = 0.5 * (distance(i) + distance(j - 1));
             if (parity)
                 out.push_back({t, 1});
             else if (sum != 0)
@@ -151,7 +190,8 @@ private:
     RTCScene scene_ = nullptr;
     Vec3d center_;
     std::vector<Vec3d> normals_;
-    double reach_ = 1;
+    double reach_ = 1;  // bounding-box diagonal
+    double unit_ = 1;   // the power of two Embree's coordinates are measured in
 };
 
 // Lattice line directions: axes, body diagonals, face diagonals (one per opposite pair).
@@ -192,12 +232,13 @@ InsideOutsideResult classify_lattice(const TriangleMesh& mesh, const LatticeGrid
                 for (int i = 0; i < grid.dims[0]; ++i)
                     if (!grid.contains(i - dx, j - dy, k - dz)) starts.push_back({i, j, k});
         rays += starts.size();
+        FirstException failure;
 #pragma omp parallel
         {
             std::vector<RawHit> hits;
             std::vector<Crossing> crossings;
 #pragma omp for schedule(dynamic, 16)
-            for (long s = 0; s < static_cast<long>(starts.size()); ++s) {
+            for (long s = 0; s < static_cast<long>(starts.size()); ++s) failure.run([&] {
                 const auto p0 = starts[static_cast<std::size_t>(s)];
                 scene.cast_line(grid.position(p0[0], p0[1], p0[2]), dir, back, result.parity, hits, crossings);
                 int total = 0;
@@ -217,8 +258,9 @@ InsideOutsideResult classify_lattice(const TriangleMesh& mesh, const LatticeGrid
                     votes[id] = static_cast<std::int16_t>(votes[id] + w_plus + w_minus);
                     positive[id] = static_cast<std::uint8_t>(positive[id] + (w_plus > 0) + (w_minus > 0));
                 }
-            }
+            });
         }
+        failure.rethrow();
     }
     result.rays = rays;
     const int samples = 2 * result.directions_used;
@@ -238,12 +280,14 @@ InsideOutsideResult classify_lattice(const TriangleMesh& mesh, const LatticeGrid
         const auto t_refine = std::chrono::steady_clock::now();
         const FastWindingNumber wn(mesh);
         const std::size_t nx = std::size_t(grid.dims[0]), ny = std::size_t(grid.dims[1]);
+        FirstException failure;
 #pragma omp parallel for schedule(dynamic, 32)
-        for (long u = 0; u < static_cast<long>(undecided.size()); ++u) {
+        for (long u = 0; u < static_cast<long>(undecided.size()); ++u) failure.run([&] {
             const std::size_t id = undecided[static_cast<std::size_t>(u)];
             const int i = int(id % nx), j = int((id / nx) % ny), k = int(id / (nx * ny));
             result.inside[id] = wn.evaluate_exact_near_half(grid.position(i, j, k)) > 0.5 ? 1 : 0;
-        }
+        });
+        failure.rethrow();
         result.refined = undecided.size();
         result.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_refine).count();
     }
@@ -257,35 +301,43 @@ std::vector<std::uint8_t> classify_points(const TriangleMesh& mesh, const std::v
     const int families = resolve_families(directions, edges.closed());
     EmbreeScene scene(mesh);
     const Vec3d center = bounding_box(mesh).center();
-    const double reach0 = scene.reach() + 1e-6;
+    const double reach = scene.reach();
     std::vector<std::uint8_t> inside(points.size(), 0);
     std::unique_ptr<FastWindingNumber> wn;
     if (!edges.closed() && !parity && refine_band > 0) wn = std::make_unique<FastWindingNumber>(mesh);
+    FirstException failure;
 #pragma omp parallel
     {
         std::vector<RawHit> hits;
         std::vector<Crossing> crossings;
 #pragma omp for schedule(dynamic, 64)
-        for (long p = 0; p < static_cast<long>(points.size()); ++p) {
+        for (long p = 0; p < static_cast<long>(points.size()); ++p) failure.run([&] {
             const Vec3d& q = points[static_cast<std::size_t>(p)];
             int votes = 0;
             for (int f = 0; f < families; ++f) {
                 const Vec3d dir = Vec3d(kFamilies[f][0], kFamilies[f][1], kFamilies[f][2]).normalized();
-                // Start the line far enough behind q to be outside the mesh's bounding sphere.
-                const double reach = reach0 + (q - center).norm();
-                scene.cast_line(q, dir, reach, parity, hits, crossings);
+                // The line through q is cast from its point nearest the mesh's centre, `reach`
+                // before it (outside the bounding box), so that however far q lies the ray starts
+                // near the mesh; q sits at t_q along it. A line passing farther than `reach` from
+                // the centre misses the bounding box and crosses nothing.
+                const double along = (q - center).dot(dir);
+                const Vec3d foot = q - along * dir;
+                const double t_q = reach + along;
+                crossings.clear();
+                if ((foot - center).norm() <= reach) scene.cast_line(foot, dir, reach, parity, hits, crossings);
                 int total = 0, before = 0;
                 for (const Crossing& c : crossings) {
                     total += c.sign;
-                    if (c.t < reach) before += c.sign;
+                    if (c.t < t_q) before += c.sign;
                 }
                 votes += parity ? (((total - before) & 1) + (before & 1)) : (total - before) + (-before);
             }
             inside[static_cast<std::size_t>(p)] = votes > families ? 1 : 0;  // mean of 2F samples > 1/2
             if (wn && std::abs(double(votes) / (2 * families) - 0.5) <= refine_band)
                 inside[static_cast<std::size_t>(p)] = wn->evaluate_exact_near_half(q) > 0.5 ? 1 : 0;
-        }
+        });
     }
+    failure.rethrow();
     return inside;
 }
 

@@ -55,7 +55,8 @@ struct InsideOutsideResult {
 };
 
 // Classifies every point of the lattice. The mesh should be outward oriented (sample_solid flips
-// meshes with negative signed volume first).
+// meshes with negative signed volume first). Throws InputError when a lattice line would start
+// more than 1e6 mesh sizes from the mesh (a grid far from it, or a spacing far larger than it).
 InsideOutsideResult classify_lattice(const TriangleMesh& mesh, const LatticeGrid& grid,
                                      const InsideOutsideOptions& options = {});
 

@@ -14,6 +14,22 @@ namespace mw {
 
 namespace {
 std::string describe(const TriangleMesh& mesh) { return mesh.source.empty() ? std::string("mesh") : mesh.source; }
+
+// Index of the first vertex that is not finite or lies outside ±kMaxCoordinate, or -1.
+long first_out_of_range(const std::vector<Vec3d>& vertices) {
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+        if (!vertices[i].allFinite() || vertices[i].cwiseAbs().maxCoeff() > kMaxCoordinate) return static_cast<long>(i);
+    return -1;
+}
+
+// Largest |coordinate| over the vertices.
+double largest_coordinate(const std::vector<Vec3d>& vertices) {
+    double largest = 0;
+    for (const Vec3d& v : vertices) largest = std::max(largest, v.cwiseAbs().maxCoeff());
+    return largest;
+}
+
+bool too_far_to_resolve(double largest, double size) { return size > 0 && largest > kMaxDistanceInMeshSizes * size; }
 }  // namespace
 
 bool MeshTransform::is_identity() const {
@@ -35,7 +51,43 @@ void apply_transform(TriangleMesh& mesh, const MeshTransform& tr) {
                                  Eigen::AngleAxisd(tr.rotation_deg.y() * d2r, Vec3d::UnitY()) *
                                  Eigen::AngleAxisd(tr.rotation_deg.x() * d2r, Vec3d::UnitX()))
                                     .toRotationMatrix();
-    for (Vec3d& v : mesh.vertices) v = rot * v.cwiseProduct(tr.scale) + tr.translation;
+    // Into a copy, so that a transform refused below leaves the mesh as it was.
+    std::vector<Vec3d> moved(mesh.vertices.size());
+    Aabb unmoved;  // the scaled and rotated mesh, before the translation
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+        const Vec3d turned = rot * mesh.vertices[i].cwiseProduct(tr.scale);
+        unmoved.lo = i ? unmoved.lo.cwiseMin(turned) : turned;
+        unmoved.hi = i ? unmoved.hi.cwiseMax(turned) : turned;
+        moved[i] = turned + tr.translation;
+    }
+    auto describe_transform = [&](std::ostream& s) {
+        s << "(scale " << tr.scale.x() << "," << tr.scale.y() << "," << tr.scale.z() << ", rotation " << tr.rotation_deg.x()
+          << "," << tr.rotation_deg.y() << "," << tr.rotation_deg.z() << ", translation " << tr.translation.x() << ","
+          << tr.translation.y() << "," << tr.translation.z() << ")";
+    };
+    // A mesh that was out of range before is validate_mesh's to report: the transform is not to blame.
+    const bool was_in_range = first_out_of_range(mesh.vertices) < 0 &&
+                              !too_far_to_resolve(largest_coordinate(mesh.vertices), bounding_box(mesh).extent().norm());
+    const long bad = was_in_range ? first_out_of_range(moved) : -1;
+    if (bad >= 0) {
+        const Vec3d& v = moved[static_cast<std::size_t>(bad)];
+        std::ostringstream s;
+        s << describe(mesh) << ": the transform ";
+        describe_transform(s);
+        s << " takes vertex " << bad + 1 << " to (" << v.x() << ", " << v.y() << ", " << v.z()
+          << "), outside the range of +-" << kMaxCoordinate << " that coordinates must lie in";
+        throw InputError(s.str());
+    }
+    const double size = unmoved.extent().norm(), largest = largest_coordinate(moved);
+    if (was_in_range && too_far_to_resolve(largest, size)) {
+        std::ostringstream s;
+        s << describe(mesh) << ": the transform ";
+        describe_transform(s);
+        s << " puts the mesh (size " << size << ") " << largest << " from the origin, too far for double precision "
+          << "to resolve it (at most " << kMaxDistanceInMeshSizes << " times its size)";
+        throw InputError(s.str());
+    }
+    mesh.vertices = std::move(moved);
     if (tr.scale.x() * tr.scale.y() * tr.scale.z() < 0) flip_orientation(mesh);
 }
 
@@ -122,9 +174,24 @@ void validate_mesh(const TriangleMesh& mesh, bool require_volume) {
                   << nv << " vertices";
                 throw InputError(s.str());
             }
-    if (!require_volume) return;
+    const long far = first_out_of_range(mesh.vertices);
+    if (far >= 0) {
+        const Vec3d& v = mesh.vertices[static_cast<std::size_t>(far)];
+        std::ostringstream s;
+        s << src << ": vertex " << far + 1 << " (" << v.x() << ", " << v.y() << ", " << v.z()
+          << ") is out of range: coordinates must lie within +-" << kMaxCoordinate;
+        throw InputError(s.str());
+    }
     const Aabb box = bounding_box(mesh);
     const Vec3d e = box.extent();
+    const double largest = largest_coordinate(mesh.vertices);
+    if (too_far_to_resolve(largest, e.norm())) {
+        std::ostringstream s;
+        s << src << ": the mesh (size " << e.norm() << ") lies " << largest << " from the origin, too far for double "
+          << "precision to resolve it (at most " << kMaxDistanceInMeshSizes << " times its size)";
+        throw InputError(s.str());
+    }
+    if (!require_volume) return;
     const double box_volume = e.x() * e.y() * e.z();
     const double vol = std::abs(signed_volume(mesh));
     if (!(box_volume > 0) || !(vol > 1e-9 * box_volume)) {

@@ -29,6 +29,15 @@ struct TriangleMesh {
     Vec3d corner(std::size_t t, int k) const { return vertices[static_cast<std::size_t>(triangles[t][k])]; }
 };
 
+// Largest |coordinate| a mesh vertex may have. Particles are stored and written in single
+// precision (largest float about 3.4e38) and the sampler cubes coordinates (volumes) in double:
+// 1e30 leaves room for both, and for the spacing and support radius around the mesh.
+constexpr double kMaxCoordinate = 1e30;
+// How far from the origin a mesh may lie, in units of its size (bounding-box diagonal). Double
+// precision resolves about 1e-16 of a coordinate; the sampler needs positions (lattice points,
+// ray origins) to about 1e-7 of the mesh's size, which holds up to 1e9 sizes away.
+constexpr double kMaxDistanceInMeshSizes = 1e9;
+
 // Scale first, then rotate (Euler angles in degrees about x, then y, then z), then translate.
 struct MeshTransform {
     Vec3d scale{1, 1, 1};
@@ -38,7 +47,9 @@ struct MeshTransform {
 };
 
 // Applies the transform in place. A mirroring scale (odd number of negative factors) also flips
-// the winding so normals stay outward. Throws InputError on a zero or non-finite scale.
+// the winding so normals stay outward. Throws InputError (leaving the mesh unchanged) on a zero
+// or non-finite scale, or when a transformed vertex leaves ±kMaxCoordinate or the mesh ends up
+// farther than kMaxDistanceInMeshSizes of its sizes from the origin.
 void apply_transform(TriangleMesh& mesh, const MeshTransform& transform);
 
 Aabb bounding_box(const TriangleMesh& mesh);
@@ -60,8 +71,10 @@ struct EdgeReport {
 EdgeReport edge_report(const TriangleMesh& mesh);
 void flip_orientation(TriangleMesh& mesh);
 
-// Checks that the mesh can be sampled: at least one triangle, finite vertices, indices in range,
-// and (when require_volume) a non-zero enclosed volume. Throws InputError "<source>: <problem>".
+// Checks that the mesh can be sampled: at least one triangle, finite vertices within
+// ±kMaxCoordinate, indices in range, not farther than kMaxDistanceInMeshSizes of its sizes from
+// the origin, and (when require_volume) a non-zero enclosed volume. Throws InputError
+// "<source>: <problem>".
 void validate_mesh(const TriangleMesh& mesh, bool require_volume = true);
 
 }  // namespace mw

@@ -4,7 +4,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <vector>
 
 #include <tiny_obj_loader.h>
 
@@ -25,6 +27,13 @@ TriangleMesh from_reader(const tinyobj::ObjReader& reader, const std::string& so
         const std::string err = first_line(reader.Error());
         throw InputError(source + ": cannot parse OBJ" + (err.empty() ? std::string() : " (" + err + ")"));
     }
+    // The reader drops invalid faces with only a warning; check_obj_text should have refused
+    // them already, and a face lost here would leave a hole, so any face warning is an error.
+    std::istringstream warnings(reader.Warning());
+    for (std::string warning; std::getline(warnings, warning);)
+        if (warning.find("face") != std::string::npos || warning.find("Face") != std::string::npos ||
+            warning.rfind("Vertex indices out of bounds", 0) == 0)
+            throw InputError(source + ": invalid OBJ (" + first_line(warning) + ")");
     const tinyobj::attrib_t& attrib = reader.GetAttrib();
     TriangleMesh mesh;
     mesh.source = source;
@@ -37,7 +46,14 @@ TriangleMesh from_reader(const tinyobj::ObjReader& reader, const std::string& so
         std::size_t offset = 0;
         for (std::size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
             const int n = shape.mesh.num_face_vertices[f];
-            // After triangulation every face has 3 corners; a face with fewer is malformed input.
+            // check_obj_text refuses faces with fewer than 3 corners; should one get here anyway
+            // it is malformed input, never something to drop in silence.
+            if (n < 3) {
+                std::ostringstream msg;
+                msg << source << ": face " << f + 1 << " of shape '" << shape.name << "' has " << n
+                    << " corners, a face needs at least 3";
+                throw InputError(msg.str());
+            }
             if (n == 3)
                 mesh.triangles.push_back({idx[offset].vertex_index, idx[offset + 1].vertex_index, idx[offset + 2].vertex_index});
             else if (n > 3)  // tinyobjloader leaves some faces untriangulated: fan them
@@ -51,35 +67,126 @@ TriangleMesh from_reader(const tinyobj::ObjReader& reader, const std::string& so
     return mesh;
 }
 
-// tinyobjloader's number parser reads "nan" and "inf" as 0, so non-finite vertices are caught
-// here, on the text, with the line number.
-void check_vertex_lines(const std::string& text, const std::string& source) {
-    std::size_t line_no = 0, vertex_no = 0, pos = 0;
+// One line of the OBJ text, for messages: its number and its content without the line break.
+struct ObjLine {
+    std::size_t number;
+    std::string text;
+    bool last_and_unterminated;  // the file ends inside this line: maybe truncated
+};
+
+std::string quoted(const ObjLine& line) {
+    std::string shown = line.text;
+    while (!shown.empty() && (shown.back() == '\r' || shown.back() == ' ' || shown.back() == '\t')) shown.pop_back();
+    return "'" + shown + "'";
+}
+
+[[noreturn]] void reject_line(const std::string& source, const ObjLine& line, const std::string& problem) {
+    std::ostringstream msg;
+    msg << source << ": " << problem << " (line " << line.number << ": " << quoted(line) << ")";
+    if (line.last_and_unterminated) msg << "; the file ends in this line without a line break: is it truncated?";
+    throw InputError(msg.str());
+}
+
+// The whitespace-separated words of `text` after its first `from` characters.
+std::vector<std::string> tokens_of(const std::string& text, std::size_t from) {
+    std::vector<std::string> tokens;
+    const char* blank = " \t\r";
+    for (std::size_t start = text.find_first_not_of(blank, from); start != std::string::npos;) {
+        const std::size_t stop = text.find_first_of(blank, start);
+        tokens.push_back(text.substr(start, stop == std::string::npos ? std::string::npos : stop - start));
+        start = stop == std::string::npos ? stop : text.find_first_not_of(blank, stop);
+    }
+    return tokens;
+}
+
+// Calls visit(line, is_vertex) for every vertex ("v ") and face ("f ") line of the OBJ text.
+template <class Visit>
+void for_each_vertex_and_face_line(const std::string& text, Visit&& visit) {
+    std::size_t pos = 0, line_no = 0;
     while (pos < text.size()) {
         std::size_t end = text.find('\n', pos);
-        if (end == std::string::npos) end = text.size();
+        const bool unterminated = end == std::string::npos;
+        if (unterminated) end = text.size();
         ++line_no;
         std::size_t p = pos;
         while (p < end && (text[p] == ' ' || text[p] == '\t')) ++p;
-        if (p + 1 < end && text[p] == 'v' && (text[p + 1] == ' ' || text[p + 1] == '\t')) {
-            ++vertex_no;
-            const std::string line = text.substr(p + 2, end - p - 2);
-            const char* c = line.c_str();
-            for (int k = 0; k < 3; ++k) {
-                char* after = nullptr;
-                const double x = std::strtod(c, &after);
-                if (after == c || !std::isfinite(x)) {
-                    std::ostringstream msg;
-                    std::string shown = line;
-                    while (!shown.empty() && (shown.back() == '\r' || shown.back() == ' ')) shown.pop_back();
-                    msg << source << ": vertex " << vertex_no << " is not finite (line " << line_no << ": 'v " << shown << "')";
-                    throw InputError(msg.str());
-                }
-                c = after;
-            }
-        }
+        if (p + 1 < end && (text[p] == 'v' || text[p] == 'f') && (text[p + 1] == ' ' || text[p + 1] == '\t'))
+            visit(ObjLine{line_no, text.substr(p, end - p), unterminated}, text[p] == 'v');
         pos = end + 1;
     }
+}
+
+// tinyobjloader is lenient where a sampler must not be: it reads "nan", "inf" and missing or
+// garbled coordinates as 0, drops faces with fewer than 3 corners or an index past the end with
+// only a warning, and parses indices with atoi (so 99999999999 wraps to another vertex). Vertex
+// and face lines are therefore checked here first, on the text, so each problem is reported with
+// its line number.
+void check_obj_text(const std::string& text, const std::string& source) {
+    // Faces may use vertices defined after them, so positive indices are checked against the
+    // file's total, counted first.
+    long long total_vertices = 0;
+    for_each_vertex_and_face_line(text, [&](const ObjLine&, bool is_vertex) { total_vertices += is_vertex; });
+    const double largest_parsed = double(std::numeric_limits<tinyobj::real_t>::max());
+    long long vertices = 0, faces = 0;
+    for_each_vertex_and_face_line(text, [&](const ObjLine& line, bool is_vertex) {
+        const std::vector<std::string> tokens = tokens_of(line.text, 2);
+        if (is_vertex) {
+            ++vertices;
+            if (tokens.size() < 3) {
+                std::ostringstream problem;
+                problem << "vertex " << vertices << " has " << tokens.size() << " coordinate"
+                        << (tokens.size() == 1 ? "" : "s") << ", a vertex needs x y z";
+                reject_line(source, line, problem.str());
+            }
+            for (int k = 0; k < 3; ++k) {
+                const std::string& token = tokens[static_cast<std::size_t>(k)];
+                char* after = nullptr;
+                const double x = std::strtod(token.c_str(), &after);
+                const bool number = after != token.c_str() && *after == '\0';
+                if (number && std::isfinite(x) && std::abs(x) <= largest_parsed) continue;
+                std::ostringstream problem;
+                problem << "vertex " << vertices;
+                if (!number)
+                    problem << ": '" << token << "' is not a number";
+                else if (!std::isfinite(x))
+                    problem << " is not finite";
+                else
+                    problem << ": " << token << " is beyond the largest coordinate the OBJ reader holds (" << largest_parsed
+                            << ")";
+                reject_line(source, line, problem.str());
+            }
+            return;
+        }
+        ++faces;
+        if (tokens.size() < 3) {
+            std::ostringstream problem;
+            problem << "face " << faces << " has " << tokens.size() << " corner" << (tokens.size() == 1 ? "" : "s")
+                    << ", a face needs at least 3";
+            reject_line(source, line, problem.str());
+        }
+        for (const std::string& corner : tokens) {
+            // "v", "v/vt", "v//vn" or "v/vt/vn": the vertex index comes first.
+            const std::string token = corner.substr(0, corner.find('/'));
+            // Read as long long, not int: an index beyond int (which the reader's atoi wraps)
+            // saturates and is reported as the number written.
+            char* after = nullptr;
+            const long long index = std::strtoll(token.c_str(), &after, 10);
+            const bool number = !token.empty() && after != token.c_str() && *after == '\0';
+            if (number && index != 0 && index >= -vertices && index <= total_vertices) continue;
+            std::ostringstream problem;
+            problem << "face " << faces;
+            if (!number)
+                problem << ": '" << corner << "' is not a vertex index";
+            else if (index == 0)
+                problem << " refers to vertex 0, but OBJ vertex indices start at 1";
+            else if (index < 0)
+                problem << " refers to vertex " << token << " (counted back from the end), but only " << vertices
+                        << " vertices precede it";
+            else
+                problem << " refers to vertex " << token << ", but the file has " << total_vertices << " vertices";
+            reject_line(source, line, problem.str());
+        }
+    });
 }
 
 tinyobj::ObjReaderConfig config() {
@@ -104,7 +211,7 @@ TriangleMesh load_obj(const std::string& path, bool require_volume) {
 }
 
 TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume) {
-    check_vertex_lines(text, source);
+    check_obj_text(text, source);
     tinyobj::ObjReader reader;
     reader.ParseFromString(text, std::string(), config());
     return from_reader(reader, source, require_volume);

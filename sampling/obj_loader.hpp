@@ -7,7 +7,10 @@
 
 namespace mw {
 // Loads and validates (validate_mesh with require_volume). Throws InputError naming the file:
-// missing or unreadable file, parse error, no triangles, non-finite vertex, bad index, no volume.
+// missing or unreadable file, parse error, no triangles, a vertex line with fewer than 3
+// coordinates or one that is not a finite number, a face with fewer than 3 corners or an index
+// that is 0, not a number or past the vertices (these name the vertex or face and the line), a
+// coordinate out of range, no volume.
 TriangleMesh load_obj(const std::string& path, bool require_volume = true);
 // The same from OBJ text (source names it in messages); used by tests.
 TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume = true);

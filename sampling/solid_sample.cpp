@@ -10,6 +10,11 @@ namespace mw {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+// The inside/outside test locates surface crossings in single precision, relative to the mesh's
+// bounding box: to about 1e-6 of its diagonal (a few float ulps of distances up to three
+// diagonals; crossings that close are also merged into one). At 1e5 spacings across the mesh
+// that is 0.1 r0, still well within a lattice cell; finer, a wall one spacing thick could vanish.
+constexpr double kMaxSpacingsAcrossMesh = 1e5;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
@@ -33,11 +38,27 @@ SolidSample sample_solid(const TriangleMesh& input, double spacing, double suppo
         st.flipped = true;
     }
     const Vec3d extent = bounding_box(mesh).extent();
+    if (spacing > extent.maxCoeff()) {
+        // Every axis would hold a single lattice point (at the centre), and the rays cast along
+        // the lattice lines start a spacing away: a spacing of 1e20 for a 1 m mesh puts them
+        // beyond the single-precision range of the ray tracer.
+        std::ostringstream s;
+        s << src << ": spacing r0 = " << spacing << " is larger than the mesh itself (bounding box " << extent.x()
+          << " x " << extent.y() << " x " << extent.z() << "); use a spacing below its largest side";
+        throw InputError(s.str());
+    }
     const double points = (extent.x() / spacing + 1) * (extent.y() / spacing + 1) * (extent.z() / spacing + 1);
     if (points > 2e9) {
         std::ostringstream s;
         s << src << ": spacing " << spacing << " is too fine for a mesh of size " << extent.x() << " x " << extent.y()
           << " x " << extent.z() << " (" << points << " lattice points)";
+        throw InputError(s.str());
+    }
+    if (extent.norm() > kMaxSpacingsAcrossMesh * spacing) {
+        std::ostringstream s;
+        s << src << ": spacing r0 = " << spacing << " is too fine for the single-precision ray tracer: the mesh's "
+          << "diagonal " << extent.norm() << " spans " << extent.norm() / spacing << " spacings, at most "
+          << kMaxSpacingsAcrossMesh << " are allowed (crossings are located to about 1e-6 of the mesh's size)";
         throw InputError(s.str());
     }
     const EdgeReport edges = edge_report(mesh);

@@ -4,9 +4,12 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 #include <unordered_map>
 
+#include "backend/errors.hpp"
 #include "sampling/kdtree.hpp"
 
 namespace mw {
@@ -80,7 +83,10 @@ SurfaceParticles sample_surface(const TriangleMesh& mesh, double spacing, const 
     const double rho = options.min_distance * spacing;
     const double fill = std::max(0.0, (options.coverage - options.candidate_gap) * spacing);
     const std::size_t nt = mesh.triangles.size();
-    if (nt > (std::size_t(1) << 31)) throw std::length_error("sample_surface: too many triangles");
+    const std::string src = mesh.source.empty() ? std::string("mesh") : mesh.source;
+    // Triangles and candidates are numbered with 32-bit ints.
+    if (nt > (std::size_t(1) << 31))
+        throw InputError(src + ": " + std::to_string(nt) + " triangles, more than the surface sampler handles (2^31)");
 
     // 1. Candidates: sub-grid vertices of every non-degenerate triangle. Points shared between
     // triangles are emitted once: a mesh vertex by its first triangle, the inner points of an edge
@@ -138,7 +144,12 @@ SurfaceParticles sample_surface(const TriangleMesh& mesh, double spacing, const 
     }
     std::partial_sum(first.begin(), first.end(), first.begin());
     const std::size_t total = first[nt];
-    if (total > (std::size_t(1) << 31)) throw std::length_error("sample_surface: too many surface candidates");
+    if (total > (std::size_t(1) << 31)) {
+        std::ostringstream msg;
+        msg << src << ": the surface needs " << total << " candidate points at spacing r0 = " << spacing
+            << ", more than the surface sampler handles (2^31); use a coarser spacing";
+        throw InputError(msg.str());
+    }
     std::vector<Candidate> cand;
     cand.resize(total);
 #pragma omp parallel for schedule(dynamic, 256)

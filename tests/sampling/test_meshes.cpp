@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include <doctest/doctest.h>
@@ -125,6 +126,69 @@ TEST_CASE("bad mesh input gives one clear error naming the file and the problem"
     }
     CHECK(error_of([&] { load_obj(path); }).rfind(path + ": vertex 4 is not finite", 0) == 0);
     std::filesystem::remove(path);
+}
+
+TEST_CASE("malformed OBJ lines are named by their line, never misreported or dropped") {
+    const std::string tet_vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+    const std::string tet_faces = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    auto error = [](const std::string& text) { return error_of([&] { parse_obj(text, "m.obj"); }); };
+    // Too few coordinates: tinyobjloader would read the missing z as 0.
+    CHECK(error("v 0 0 0\nv 1 0\nv 0 1 0\nv 0 0 1\n" + tet_faces) ==
+          "m.obj: vertex 2 has 2 coordinates, a vertex needs x y z (line 2: 'v 1 0')");
+    // A file cut off in the middle of a vertex line says so.
+    const std::string truncated = error(tet_faces + tet_vertices + "v 1 2");
+    CHECK(truncated.rfind("m.obj: vertex 5 has 2 coordinates, a vertex needs x y z (line 9: 'v 1 2')", 0) == 0);
+    CHECK(truncated.find("truncated") != std::string::npos);
+    CHECK(error("v 0 0 0\nv 1 0 0\nv 0 1,5 0\nv 0 0 1\n" + tet_faces) ==
+          "m.obj: vertex 3: '1,5' is not a number (line 3: 'v 0 1,5 0')");
+    CHECK(error("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e39\n" + tet_faces).rfind("m.obj: vertex 4: 1e39 is beyond", 0) == 0);
+    // Faces with fewer than 3 corners are errors, not silently dropped.
+    CHECK(error(tet_vertices + tet_faces + "f 1 3\n") == "m.obj: face 5 has 2 corners, a face needs at least 3 (line 9: 'f 1 3')");
+    CHECK(error(tet_vertices + "f \n" + tet_faces).rfind("m.obj: face 1 has 0 corners", 0) == 0);
+    // Indices are reported as written: tinyobjloader's atoi wraps 99999999999 to 1215752191.
+    CHECK(error(tet_vertices + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 99999999999\n") ==
+          "m.obj: face 4 refers to vertex 99999999999, but the file has 4 vertices (line 8: 'f 3 1 99999999999')");
+    // A quad with a bad index: tinyobjloader would drop it with a warning.
+    CHECK(error(tet_vertices + "f 1 2 3 9\n" + tet_faces) ==
+          "m.obj: face 1 refers to vertex 9, but the file has 4 vertices (line 5: 'f 1 2 3 9')");
+    CHECK(error(tet_vertices + "f 0 1 2\n").rfind("m.obj: face 1 refers to vertex 0, but OBJ vertex indices start at 1", 0) == 0);
+    CHECK(error(tet_vertices + "f -1 -2 -5\n").rfind("m.obj: face 1 refers to vertex -5 (counted back from the end), but "
+                                                     "only 4 vertices precede it", 0) == 0);
+    CHECK(error(tet_vertices + "f 1 2 x\n").rfind("m.obj: face 1: 'x' is not a vertex index", 0) == 0);
+    // Still accepted: relative indices, v/vt/vn corners, faces before the vertices they use.
+    CHECK(parse_obj(tet_vertices + "f -4 -2 -3\nf -4 -3 -1\nf -3 -2 -1\nf -2 -4 -1\n", "rel.obj").triangles.size() == 4);
+    CHECK(parse_obj(tet_vertices + "vt 0 0\nvn 0 0 1\nf 1/1/1 3/1/1 2/1/1\nf 1//1 2//1 4//1\nf 2/1 3/1 4/1\nf 3 1 4\n",
+                    "vtvn.obj").triangles.size() == 4);
+    CHECK(parse_obj(tet_faces + tet_vertices, "faces_first.obj").triangles.size() == 4);
+}
+
+TEST_CASE("coordinates out of range or too far to resolve: one clear error, the mesh left as it was") {
+    TriangleMesh box = make_box(Vec3d(1, 1, 1));
+    box.source = "box";
+    const std::vector<Vec3d> before = box.vertices;
+    MeshTransform huge;
+    huge.scale = Vec3d(1e300, 1e300, 1e300);
+    const std::string overflow = error_of([&] { apply_transform(box, huge); });
+    CHECK(overflow.rfind("box: the transform (scale 1e+300,1e+300,1e+300, rotation 0,0,0, translation 0,0,0) takes "
+                         "vertex 1 to (-5e+299, -5e+299, -5e+299), outside the range", 0) == 0);
+    CHECK(box.vertices == before);
+    MeshTransform far;
+    far.translation = Vec3d(1e30, 0, 0);
+    const std::string unresolved = error_of([&] { apply_transform(box, far); });
+    CHECK(unresolved.find("too far for double precision to resolve it") != std::string::npos);
+    CHECK(box.vertices == before);
+    far.translation = Vec3d(1e8, 0, 0);  // 1e8 box sizes away: still resolved to 1e-8 of its size
+    CHECK_NOTHROW(apply_transform(box, far));
+    // The same limits for meshes read as they are.
+    TriangleMesh big = make_box(Vec3d(1, 1, 1));
+    big.source = "big.obj";
+    big.vertices[0] = Vec3d(1e31, 0, 0);
+    CHECK(error_of([&] { validate_mesh(big); }).rfind("big.obj: vertex 1 (1e+31, 0, 0) is out of range", 0) == 0);
+    TriangleMesh distant = make_box(Vec3d(1, 1, 1));
+    distant.source = "distant.obj";
+    for (Vec3d& v : distant.vertices) v.x() += 1e12;
+    CHECK(error_of([&] { validate_mesh(distant); }).rfind("distant.obj: the mesh (size 1.73205) lies 1e+12 from the origin", 0) ==
+          0);
 }
 
 TEST_CASE("the shared meshes load with the expected topology") {

@@ -2,10 +2,13 @@
 // inside/outside test on closed and open meshes.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <set>
+#include <string>
 
 #include <doctest/doctest.h>
 
+#include "backend/errors.hpp"
 #include "sampling/inside_outside.hpp"
 #include "sampling/kdtree.hpp"
 #include "sampling/obj_loader.hpp"
@@ -254,4 +257,54 @@ TEST_CASE("stanford-bunny.obj (open, 223 boundary edges): body filled, no IBP ou
     CHECK(border_ibps_outside(bunny, s.ibp) == 0);
     CHECK(s.stats.largest_gap <= 0.6 * r0);
     check_sbp_embedding(bunny, s.sbp, r0);
+}
+
+TEST_CASE("inside/outside does not depend on the mesh's scale (the ray tracer works in float)") {
+    // Embree multiplies three coordinates in single precision: unscaled, a box of side 7e25 gave
+    // infinite hit distances and one of side 3e-25 underflowed, both classified as empty. (Sides
+    // around 1e13 made the sampler loop for ever: tests/sampling_cli checks those under a timeout.)
+    const TriangleMesh unit = make_box(Vec3d(1, 1, 1));
+    const InnerParticles reference = sample_inner(unit, 0.1);
+    REQUIRE(reference.count() == 1000);
+    for (const double scale : {3e-25, 1e-13, 7e25}) {
+        CAPTURE(scale);
+        TriangleMesh box = make_box(Vec3d(scale, scale, scale));
+        const InnerParticles ibp = sample_inner(box, 0.1 * scale);
+        CHECK(ibp.count() == 1000);
+        CHECK(ibp.classification.ambiguous == 0);
+        CHECK(ibp.lattice == reference.lattice);
+        const std::vector<Vec3d> probes = {{0, 0, 0}, {0.49 * scale, 0.3 * scale, -0.2 * scale}, {0.51 * scale, 0, 0},
+                                           {2 * scale, 2 * scale, 2 * scale}, {1e6 * scale, 0, 0}};
+        CHECK(classify_points(box, probes) == std::vector<std::uint8_t>{1, 1, 0, 0, 0});
+    }
+}
+
+TEST_CASE("spacings the ray tracer cannot handle are refused with one line, never an abort") {
+    const TriangleMesh sphere = make_sphere(1.0, 3);
+    auto error_of = [](const std::function<void()>& f) -> std::string {
+        try {
+            f();
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    // Larger than the mesh: the lattice lines would start 1e20 away, which made Embree assert.
+    CHECK(error_of([&] { sample_solid(sphere, 1e20, 2.5e20); }).find("is larger than the mesh itself") != std::string::npos);
+    CHECK(error_of([&] { sample_solid(sphere, 2.5, 6); }).find("is larger than the mesh itself") != std::string::npos);
+    CHECK(sample_solid(sphere, 1.5, 3.75).stats.ibp_count == 1);  // one lattice point, at the centre
+    // Called directly, the lattice classifier refuses such lines too (its exception crosses the
+    // OpenMP region instead of terminating the process).
+    CHECK(error_of([&] { sample_inner(sphere, 1e20); }).find("beyond what the single-precision ray tracer handles") !=
+          std::string::npos);
+    // Finer than single precision resolves: a needle 2e5 spacings long.
+    const TriangleMesh needle = make_box(Vec3d(2e5, 1, 1));
+    CHECK(error_of([&] { sample_solid(needle, 1.0, 2.5); }).find("too fine for the single-precision ray tracer") !=
+          std::string::npos);
+    // More surface candidates than 32-bit numbering holds: an InputError, refused before allocating.
+    TriangleMesh triangle;
+    triangle.source = "triangle";
+    triangle.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    triangle.triangles = {{0, 1, 2}};
+    CHECK(error_of([&] { sample_surface(triangle, 1e-5); }).rfind("triangle: the surface needs ", 0) == 0);
 }

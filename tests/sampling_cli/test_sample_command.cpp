@@ -20,8 +20,10 @@ struct Run {
     std::string output;  // stdout and stderr together
 };
 
-Run run_sample(const std::string& args) {
-    const std::string cmd = std::string("OMP_NUM_THREADS=2 '") + MW_BINARY + "' sample " + args + " 2>&1";
+// `limits` goes before the command in the shell (e.g. a timeout and an address-space limit for
+// inputs that once hung or ate memory, so that a regression fails instead of stalling the suite).
+Run run_sample(const std::string& args, const std::string& limits = "") {
+    const std::string cmd = "export OMP_NUM_THREADS=2; " + limits + " '" + MW_BINARY + "' sample " + args + " 2>&1";
     Run r;
     FILE* p = popen(cmd.c_str(), "r");
     REQUIRE(p != nullptr);
@@ -32,6 +34,8 @@ Run run_sample(const std::string& args) {
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
 }
+
+const std::string kGuard = "ulimit -v 4000000; timeout 30";
 
 std::string read_file(const std::filesystem::path& p) {
     std::ifstream in(p, std::ios::binary);
@@ -118,9 +122,30 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
         {"box --spacing 0.1 --scale 1,2" + out, "--scale"},
         {"box --spacing 0.1 --directions 5" + out, "--directions"},
         {"box --spacing 0.1 --bogus" + out, "bogus"},
+        // OBJ lines tinyobjloader misreads or drops.
+        {write("two.obj", "v 0 0 0\nv 1 0\nv 0 1 0\nv 0 0 1\n" + tet) + " --spacing 0.1" + out,
+         "two.obj: vertex 2 has 2 coordinates, a vertex needs x y z (line 2: 'v 1 0')"},
+        {write("cut.obj", tet + "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0") + " --spacing 0.1" + out,
+         "cut.obj: vertex 4 has 2 coordinates, a vertex needs x y z (line 8: 'v 0 0'); the file ends in this line"},
+        {write("edge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + tet + "f 1 3\n") + " --spacing 0.1" + out,
+         "edge.obj: face 5 has 2 corners, a face needs at least 3 (line 9: 'f 1 3')"},
+        {write("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 99999999999\n") +
+             " --spacing 0.1" + out,
+         "huge.obj: face 4 refers to vertex 99999999999, but the file has 4 vertices (line 8"},
+        // Spacings and transforms out of range.
+        {"sphere:radius=1 --spacing 1e20" + out, "sphere:radius=1: spacing r0 = 1e+20 is larger than the mesh itself"},
+        {"box:x=200000,y=1,z=1 --spacing 1" + out, "too fine for the single-precision ray tracer"},
+        {"box --spacing 0.1 --scale 1e300" + out, "box: the transform (scale 1e+300,1e+300,1e+300"},
+        {"box --spacing 0.1 --translate 1e30,0,0" + out, "too far for double precision to resolve it"},
+        // A mesh with no inner particle is refused, as `meltwater run` refuses it.
+        {write("small.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + tet) + " --spacing 0.9" + out,
+         "small.obj: the mesh holds no inner particle at spacing 0.9 (make it larger or decrease --spacing)"},
+        {"box --spacing 0.1 --threads -5" + out, "--threads must be between 1 and 1024, got -5"},
+        {"box --spacing 0.1 --threads 0" + out, "--threads must be between 1 and 1024, got 0"},
+        {"box --spacing 0.1 --threads 100000" + out, "--threads must be between 1 and 1024, got 100000"},
     };
     for (const Case& c : cases) {
-        const Run r = run_sample(c.args);
+        const Run r = run_sample(c.args, kGuard);
         INFO(c.args << "\n" << r.output);
         CHECK(r.code == 2);
         CHECK(r.output.rfind("meltwater: error: ", 0) == 0);
@@ -128,5 +153,48 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
         CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
     }
     CHECK_FALSE(std::filesystem::exists(dir / "out"));
+    std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("meshes of any size: the ray tracer's float range no longer hangs or exhausts memory") {
+    const auto dir = temp_dir("scale");
+    std::ofstream(dir / "tet.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    const struct {
+        std::string args, counts;
+    } cases[] = {
+        {"box:x=1,y=1,z=1 --spacing 1e12 --scale 1e13", "IBP 1000,"},
+        {"'" + (dir / "tet.obj").string() + "' --spacing 1e14 --scale 1e15", "IBP 165,"},
+        {"box:x=1,y=1,z=1 --spacing 1e-14 --scale 1e-13", "IBP 1000,"},
+    };
+    for (const auto& c : cases) {
+        const Run r = run_sample(c.args + " --no-coverage --out '" + (dir / "out").string() + "'", kGuard);
+        INFO(c.args << "\n" << r.output);
+        CHECK(r.code == 0);
+        CHECK(r.output.find(c.counts) != std::string::npos);
+    }
+    std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("--out is made and checked before sampling, and removed again when sampling fails") {
+    const auto dir = temp_dir("out");
+    std::ofstream(dir / "file") << "not a directory";
+    // Checked first: a spacing refused by the sampler is not what gets reported.
+    Run r = run_sample("box --spacing 1e-5 --out '" + (dir / "file" / "out").string() + "'", kGuard);
+    INFO(r.output);
+    CHECK(r.code == 2);
+    CHECK(r.output.find("cannot create output directory") != std::string::npos);
+    CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
+    // Sampling fails after the directory (and its missing parents) were made: all removed again.
+    r = run_sample("box --spacing 1e-5 --out '" + (dir / "new" / "deeper").string() + "'", kGuard);
+    INFO(r.output);
+    CHECK(r.code == 2);
+    CHECK(r.output.find("too fine") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir / "new"));
+    // A directory that was there before stays, with what it held.
+    std::filesystem::create_directories(dir / "kept");
+    std::ofstream(dir / "kept" / "notes.txt") << "mine";
+    r = run_sample("box --spacing 1e-5 --out '" + (dir / "kept").string() + "'", kGuard);
+    CHECK(r.code == 2);
+    CHECK(read_file(dir / "kept" / "notes.txt") == "mine");
     std::filesystem::remove_all(dir);
 }
