@@ -6,6 +6,7 @@
 // Groups order the moving range: fluid first, then boundary particles of moving solids (SBP,
 // IBP), then particles no one gathers from (GPs, and particles that left the grid: "lost").
 #pragma once
+#include <cstdio>
 #include <cmath>
 
 #include "algorithms/particle_store.hpp"
@@ -167,18 +168,24 @@ class NeighborGrid {
         h = h / cells_per_h;
         shape_.origin = lo;
         shape_.inv_cell = Real(1) / h;
+        // Counted in double first: a domain 1e9 supports long would overflow an int cell count.
+        double cells = 1;
+        const Real extent[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+        for (int a = 0; a < 3; ++a) cells *= std::max(1.0, std::ceil(double(extent[a]) / double(h)));
+        if (!(cells * kGroupCount < double(std::uint64_t(1) << 32))) {
+            char count_text[32];
+            std::snprintf(count_text, sizeof count_text, "%.3g", cells);
+            throw InputError(std::string("the domain is too large for its support radius: ") + count_text +
+                             " grid cells (at most about 1.4e9); shrink the domain or enlarge the support radius "
+                             "(scene keys domain, fluid.support_radius)");
+        }
         std::uint64_t count = 1;
         int largest = 1;
-        const Real extent[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
         for (int a = 0; a < 3; ++a) {
             shape_.dims[a] = std::max(1, static_cast<int>(std::ceil(extent[a] / h)));
             count *= static_cast<std::uint64_t>(shape_.dims[a]);
             largest = std::max(largest, shape_.dims[a]);
         }
-        if (count * kGroupCount >= (std::uint64_t(1) << 32))
-            throw InputError("the domain is too large for its support radius: " + std::to_string(count) +
-                             " grid cells (at most about 1.4e9); shrink the domain or enlarge the support radius "
-                             "(scene keys domain, fluid.support_radius)");
         shape_.cell_count = static_cast<std::uint32_t>(count);
         int bits = 0;
         while ((1 << bits) < largest) ++bits;

@@ -135,6 +135,12 @@ void check_host_memory(const Scene& scene, const std::string& backend, bool host
                           format_bytes(available) + " is available; increase fluid.spacing or shrink the scene");
 }
 
+std::string format_number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
+
 std::string with_thousands(long n) {
     std::string digits = std::to_string(n < 0 ? -n : n), out;
     for (std::size_t i = 0; i < digits.size(); ++i) {

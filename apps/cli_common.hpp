@@ -44,6 +44,7 @@ std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, cons
 void check_host_memory(const Scene& scene, const std::string& backend, bool host_layout);
 
 std::string with_thousands(long n);
+std::string format_number(double v);  // %g: 1e+300, 0.02
 std::string format_bytes(double bytes);
 std::string format_duration(double seconds);  // h:mm:ss or m:ss
 

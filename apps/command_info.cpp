@@ -57,7 +57,7 @@ int command_info(int argc, char** argv) {
         j["stages"] = stages;
         j["frames"] = frames;
         j["scene"] = scene.resolved;
-        std::printf("%s\n", j.dump(2).c_str());
+        std::printf("%s\n", j.dump(2, ' ', false, SceneJson::error_handler_t::replace).c_str());
         return 0;
     }
 

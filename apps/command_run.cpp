@@ -21,6 +21,32 @@ namespace {
 volatile std::sig_atomic_t g_interrupted = 0;
 extern "C" void on_interrupt(int) { g_interrupted = 1; }
 
+// Ctrl-C, a terminal closing and a polite kill (a job scheduler's time limit) stop the run after
+// the current step, with whole stats.csv and summary.json and no partial frame; during set-up,
+// before the first step, with nothing written. Installed for the whole command, restored after.
+class StopSignals {
+   public:
+    StopSignals() {
+        g_interrupted = 0;
+        for (int k = 0; k < kCount; ++k) previous_[k] = std::signal(kSignals[k], on_interrupt);
+    }
+    ~StopSignals() {
+        for (int k = 0; k < kCount; ++k) std::signal(kSignals[k], previous_[k]);
+    }
+    StopSignals(const StopSignals&) = delete;
+    StopSignals& operator=(const StopSignals&) = delete;
+
+   private:
+    static constexpr int kCount = 3;
+    static constexpr int kSignals[kCount] = {SIGINT, SIGTERM, SIGHUP};
+    void (*previous_[kCount])(int);
+};
+
+int report_interrupted_setup() {
+    std::fprintf(stderr, "meltwater: interrupted during set-up, before the first step; nothing was written\n");
+    return 130;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -58,13 +84,15 @@ int command_run(int argc, char** argv) {
             throw InputError("--threads must be in [1, 1024], got " + std::to_string(threads));
     }
     const bool quiet = args.count("quiet") > 0;
+    const StopSignals stop_signals;
 
     Scene scene = scene_from_options(args, overrides);
     double end_time = scene.end_time;
     if (args.count("time")) {
         end_time = args["time"].as<double>();
-        if (!(end_time > 0) || !std::isfinite(end_time))
-            throw InputError("--time must be a positive number of seconds, got " + std::to_string(end_time));
+        // The same bound as run.end_time: 1e300 s would run for ever.
+        if (!(end_time > 0) || !(end_time <= 1e6))
+            throw InputError("--time must be in (0, 1e6] seconds, got " + format_number(end_time));
     }
     const std::string backend = choose_backend(args["backend"].as<std::string>());
     if (threads > 0 && backend != "openmp" && !quiet)
@@ -75,18 +103,27 @@ int command_run(int argc, char** argv) {
 
     check_host_memory(scene, backend, backend == "openmp");
     const SimulationSetup setup = build_setup(scene);
-    // Before the simulation is built, so that an unwritable --out fails at once; a directory made
-    // here is removed again (if still empty) when the simulation cannot be built.
-    std::error_code exists_error;
-    const bool out_existed = std::filesystem::exists(out_dir, exists_error);
-    make_directories(out_dir);
+    if (g_interrupted) return report_interrupted_setup();
+    // Before the simulation is built, so that an unwritable --out fails at once; the directories
+    // made here are removed again (if still empty) when the run ends before its first step.
+    const std::vector<std::string> created = make_directories(out_dir);
     std::unique_ptr<Simulation> sim;
     try {
+        // stats.csv, summary.json and frames/ are renamed into place at the end: something else
+        // by those names would only fail then, after the whole run.
+        for (const char* name : {"stats.csv", "summary.json"})
+            if (std::filesystem::is_directory(out_dir + "/" + name))
+                throw InputError(out_dir + "/" + name + " is a directory; the run writes a file there");
+        if (std::filesystem::exists(out_dir + "/frames") && !std::filesystem::is_directory(out_dir + "/frames"))
+            throw InputError(out_dir + "/frames is a file; the run writes its frames into a directory there");
         sim = create_simulation(setup, backend, threads);
     } catch (...) {
-        std::error_code ignored;
-        if (!out_existed) std::filesystem::remove(out_dir, ignored);
+        remove_created_directories(created);
         throw;
+    }
+    if (g_interrupted) {
+        remove_created_directories(created);
+        return report_interrupted_setup();
     }
 
     const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
@@ -130,12 +167,6 @@ int command_run(int argc, char** argv) {
         ++frame_index;
     };
 
-    // Ctrl-C, a terminal closing and a polite kill (a job scheduler's time limit) all stop the run
-    // after the current step, with whole stats.csv and summary.json and no partial frame.
-    g_interrupted = 0;
-    const int stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
-    void (*previous_handlers[3])(int);
-    for (int k = 0; k < 3; ++k) previous_handlers[k] = std::signal(stop_signals[k], on_interrupt);
     std::exception_ptr failure;
     bool interrupted = false;
     try {
@@ -188,7 +219,6 @@ int command_run(int argc, char** argv) {
     } catch (...) {
         failure = std::current_exception();
     }
-    for (int k = 0; k < 3; ++k) std::signal(stop_signals[k], previous_handlers[k]);
 
     summary.wall_seconds = seconds_since(wall_start);
     summary.frames = frames ? frames->written() : 0;

@@ -50,25 +50,7 @@ constexpr int kMaxThreads = 1024;
 // files is no result) and the directories it created, so a failed call leaves no partial output.
 class OutputDirectory {
 public:
-    explicit OutputDirectory(const std::string& path) : path_(path) {
-        // The outermost missing directory: everything from there down is made by this call.
-        std::error_code error;
-        // Not normalised: "x/../y" makes x too. Each "p/.." comes before p in the list, so its
-        // removal meets p's parent while it still holds p, and leaves it alone.
-        std::filesystem::path full = std::filesystem::absolute(path_, error);
-        if (!full.has_filename()) full = full.parent_path();  // "out/" names the directory "out"
-        for (std::filesystem::path p = full; !error && !p.empty(); p = p.parent_path()) {
-            if (std::filesystem::exists(p, error) || error) break;
-            created_.push_back(p);
-            if (p == p.parent_path()) break;
-        }
-        try {
-            make_directories(path_);
-        } catch (...) {
-            remove_created();
-            throw;
-        }
-    }
+    explicit OutputDirectory(const std::string& path) : path_(path), created_(make_directories(path)) {}
     OutputDirectory(const OutputDirectory&) = delete;
     OutputDirectory& operator=(const OutputDirectory&) = delete;
     ~OutputDirectory() {
@@ -77,7 +59,7 @@ public:
             std::error_code ignored;
             for (const char* name : kFiles) std::filesystem::remove(path_of(name), ignored);
         }
-        remove_created();
+        remove_created_directories(created_);
     }
     static constexpr const char* kFiles[] = {"sbp.vtu", "ibp.vtu", "gp.vtu"};
     // Path of one of kFiles; asking for it means it is about to be written.
@@ -89,13 +71,8 @@ public:
 
 private:
     std::string path_of(const char* name) const { return (std::filesystem::path(path_) / name).string(); }
-    void remove_created() const {
-        std::error_code ignored;
-        // Innermost first; remove() leaves a directory that is not empty alone.
-        for (const std::filesystem::path& p : created_) std::filesystem::remove(p, ignored);
-    }
     std::string path_;
-    std::vector<std::filesystem::path> created_;  // innermost first
+    std::vector<std::string> created_;  // by this call, innermost first
     bool written_ = false;
     bool kept_ = false;
 };
@@ -147,7 +124,10 @@ int command_sample(int argc, char** argv) {
     const double r0 = args["spacing"].as<double>();
     if (!std::isfinite(r0) || r0 <= 0) throw InputError("--spacing must be a positive number");
     const double h = args.count("support") ? args["support"].as<double>() : 2.5 * r0;
-    if (!std::isfinite(h) || h <= 0) throw InputError("--support must be a positive number");
+    // The same range as a scene's fluid.support_radius: a huge h links every GP to every IBP.
+    if (!std::isfinite(h) || !(h > r0) || h > 4 * r0)
+        throw InputError("--support must be in (spacing, 4 x spacing], got " + format_number(h) + " with spacing " +
+                         format_number(r0));
     const int directions = args["directions"].as<int>();
     if (directions != 0 && directions != 3 && directions != 7 && directions != 13)
         throw InputError("--directions must be 0, 3, 7 or 13");

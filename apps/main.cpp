@@ -10,27 +10,12 @@
 #include "backend/errors.hpp"
 
 namespace {
-// Messages quote what the user wrote (keys, names, paths); a control character in it must not
-// break the one-line message, nor send escape codes to the terminal.
-std::string one_line(const char* text) {
-    std::string out;
-    for (const char* c = text; *c; ++c) {
-        const unsigned char u = static_cast<unsigned char>(*c);
-        if (u >= 0x20 && u != 0x7f) {
-            out += *c;
-        } else if (u == '\n') {
-            out += "\\n";
-        } else {
-            char escaped[8];
-            std::snprintf(escaped, sizeof escaped, "\\x%02x", u);
-            out += escaped;
-        }
-    }
-    return out;
-}
+// The error types escape their own messages (mw::printable); other exceptions' messages and the
+// command name are escaped here.
+std::string one_line(const char* text) { return mw::printable(text); }
 
-void print_usage() {
-    std::printf(
+void print_usage(std::FILE* to) {
+    std::fprintf(to,
         "usage: meltwater <command> [options]\n"
         "  run [SCENE]      simulate a scene (the built-in 3D dam break when no scene is given)\n"
         "  info [SCENE]     particle counts, memory estimate and the stages that will run\n"
@@ -42,7 +27,7 @@ void print_usage() {
 
 int main(int argc, char** argv) {
     if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-        print_usage();
+        print_usage(argc < 2 ? stderr : stdout);  // no command is an error: usage on stderr, exit 2
         return argc < 2 ? 2 : 0;
     }
     const std::string command = argv[1];

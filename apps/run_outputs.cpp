@@ -209,7 +209,8 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;
     j["frames"] = run.frames;
     j["scene"] = scene.resolved;
-    const std::string text = j.dump(2) + "\n";
+    // A path given on the command line may hold bytes that are not UTF-8: replaced, never fatal.
+    const std::string text = j.dump(2, ' ', false, SceneJson::error_handler_t::replace) + "\n";
     write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }
 

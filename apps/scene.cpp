@@ -11,6 +11,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <unordered_set>
 
 #include "backend/errors.hpp"
 
@@ -76,6 +77,18 @@ std::string representable_range() {
     return std::string("outside what the simulation's ") + (sizeof(Real) == 4 ? "float" : "double") +
            " numbers hold (magnitudes " + format_number(double(std::numeric_limits<Real>::min())) + " to " +
            format_number(double(std::numeric_limits<Real>::max())) + ", or 0)";
+}
+
+bool valid_utf8(const std::string& text) {
+    for (std::size_t i = 0; i < text.size();) {
+        const unsigned char c = static_cast<unsigned char>(text[i]);
+        const int extra = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
+        if (extra < 0 || i + std::size_t(extra) >= text.size() + (extra == 0)) return false;
+        for (int k = 1; k <= extra; ++k)
+            if ((static_cast<unsigned char>(text[i + k]) >> 6) != 0x2) return false;
+        i += 1 + std::size_t(extra);
+    }
+    return true;
 }
 
 // Edits (insert, delete, substitute, swap two neighbours) turning a into b: how a misspelt key
@@ -194,6 +207,8 @@ class Section {
         if (v) {
             if (!v->is_string()) fail(key_path(key), "expected a string, got " + type_name(*v));
             value = v->get<std::string>();
+            // JSON text is UTF-8; a Latin-1 byte would only fail when summary.json is written.
+            if (!valid_utf8(value)) fail(key_path(key), "the text is not valid UTF-8");
         }
         out_[key] = value;
         return value;
@@ -250,6 +265,10 @@ class Section {
         out_[key] = SceneJson::array();
         if (!v) return;
         if (!v->is_array()) fail(key_path(key), "expected an array, got " + type_name(*v));
+        // Blocks, boxes and objects are checked against each other pairwise; a scene needs tens.
+        constexpr std::size_t kMaxElements = 10000;
+        if (v->size() > kMaxElements)
+            fail(key_path(key), "at most " + std::to_string(kMaxElements) + " elements, got " + std::to_string(v->size()));
         for (std::size_t i = 0; i < v->size(); ++i) {
             SceneJson element;
             Section s(&(*v)[i], key_path(key) + "[" + std::to_string(i) + "]", element, source_);
@@ -432,7 +451,8 @@ void read_object_mesh(Section s, SceneObject& o) {
     o.mesh_file = s.string("file", "");
     o.mesh_procedural = s.string("procedural", "");
     if (o.mesh_file.empty() == o.mesh_procedural.empty())
-        s.fail(s.path(), "give exactly one of \"file\" (an OBJ file) or \"procedural\" (e.g. \"sphere:radius=0.1\")");
+        s.fail(s.path(), "give exactly one of \"file\" (an OBJ file) or \"procedural\" (e.g. \"sphere:radius=0.1\")" +
+                             s.misspelling_hint(o.mesh_file.empty() ? "file" : "procedural"));
     s.finish();
 }
 
@@ -550,6 +570,39 @@ std::string list_keys(const SceneJson& obj) {
 }
 
 // Applies one override to `raw`, after checking that its path names a key of the resolved scene.
+// JSON text parsed as nlohmann does, except that a key given twice in one object is refused,
+// naming the key and where it is (nlohmann keeps the last; in a scene that is almost always an
+// edit gone wrong). Parse errors are nlohmann's exceptions; `source` prefixes the message.
+SceneJson parse_json_refusing_duplicates(const std::string& text, const std::string& source) {
+    struct Container {
+        bool is_array;
+        std::string name;                    // its key in the parent object, "[]" in an array, "" at the top
+        std::unordered_set<std::string> keys;  // a set: a file of 100k keys must not take minutes
+    };
+    std::vector<Container> open;
+    std::string last_key;
+    auto refuse_duplicates = [&](int /*depth*/, SceneJson::parse_event_t event, SceneJson& parsed) {
+        using Event = SceneJson::parse_event_t;
+        if (event == Event::object_start || event == Event::array_start) {
+            const std::string name = open.empty() ? "" : open.back().is_array ? "[]" : last_key;
+            open.push_back({event == Event::array_start, name, {}});
+        } else if (event == Event::object_end || event == Event::array_end) {
+            open.pop_back();
+        } else if (event == Event::key) {
+            last_key = parsed.get<std::string>();
+            if (!open.back().keys.insert(last_key).second) {
+                std::string path;
+                for (std::size_t k = 1; k < open.size(); ++k)
+                    path += (open[k].name == "[]" || path.empty() ? "" : ".") + open[k].name;
+                path += (path.empty() ? "" : ".") + last_key;
+                throw InputError(source + ": " + path + ": the key appears twice in its object");
+            }
+        }
+        return true;
+    };
+    return SceneJson::parse(text, refuse_duplicates);
+}
+
 void apply_override(SceneJson& raw, const SceneJson& resolved, const std::string& option) {
     const auto eq = option.find('=');
     if (eq == std::string::npos || eq == 0)
@@ -565,7 +618,10 @@ void apply_override(SceneJson& raw, const SceneJson& resolved, const std::string
             auto it = r->find(p);
             if (it == r->end())
                 throw InputError("--set " + key + ": no such key in the scene" +
-                                 (walked.empty() ? "" : " (" + walked + " has: " + list_keys(*r) + ")") +
+                                 (walked.empty() ? ""
+                                  : r->empty() ? " (" + walked + " has no keys until it is set; set it whole, e.g. --set '" +
+                                                     walked + "={...}')"
+                                               : " (" + walked + " has: " + list_keys(*r) + ")") +
                                  (walked.empty() ? " (top-level keys: " + list_keys(*r) + ")" : ""));
             r = &*it;
         } else if (r->is_array()) {
@@ -581,7 +637,7 @@ void apply_override(SceneJson& raw, const SceneJson& resolved, const std::string
 
     SceneJson value;
     try {
-        value = SceneJson::parse(text);
+        value = parse_json_refusing_duplicates(text, "--set " + key);
     } catch (const SceneJson::parse_error&) {
         value = text;  // not JSON: a plain string (e.g. --set solver.dt_mode=cfl)
     } catch (const SceneJson::exception&) {
@@ -676,7 +732,9 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_objects(root, scene);
     if (scene.fluid_blocks.empty() && scene.objects.empty())
         root.fail("fluid_blocks",
-                  "at least one fluid block (or one object) is needed" + root.misspelling_hint("fluid_blocks"));
+                  "at least one fluid block (or one object) is needed" +
+                      (root.misspelling_hint("fluid_blocks").empty() ? root.misspelling_hint("objects")
+                                                                     : root.misspelling_hint("fluid_blocks")));
     read_run(root.object("run"), scene);
     read_output(root.object("output"), scene);
     root.finish();
@@ -686,38 +744,8 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
 
 Scene parse_scene_text(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
     SceneJson raw;
-    // nlohmann keeps the last of two equal keys in an object; in a scene that is almost always an
-    // edit gone wrong, so it is refused, naming the key and where it is.
-    struct Container {
-        bool is_array;
-        std::string name;  // its key in the parent object, "[]" in a parent array, "" for the root
-        std::vector<std::string> keys;
-    };
-    std::vector<Container> open;
-    std::string last_key;
-    auto refuse_duplicates = [&](int /*depth*/, SceneJson::parse_event_t event, SceneJson& parsed) {
-        using Event = SceneJson::parse_event_t;
-        if (event == Event::object_start || event == Event::array_start) {
-            const std::string name = open.empty() ? "" : open.back().is_array ? "[]" : last_key;
-            open.push_back({event == Event::array_start, name, {}});
-        } else if (event == Event::object_end || event == Event::array_end) {
-            open.pop_back();
-        } else if (event == Event::key) {
-            last_key = parsed.get<std::string>();
-            std::vector<std::string>& keys = open.back().keys;
-            if (std::find(keys.begin(), keys.end(), last_key) != keys.end()) {
-                std::string path;
-                for (std::size_t k = 1; k < open.size(); ++k)
-                    path += (open[k].name == "[]" || path.empty() ? "" : ".") + open[k].name;
-                path += (path.empty() ? "" : ".") + last_key;
-                throw InputError(source + ": " + path + ": the key appears twice in its object");
-            }
-            keys.push_back(last_key);
-        }
-        return true;
-    };
     try {
-        raw = SceneJson::parse(text, refuse_duplicates);
+        raw = parse_json_refusing_duplicates(text, source);
     } catch (const SceneJson::exception& e) {
         // nlohmann's message starts with "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
         // (or out_of_range.406 "number overflow parsing '1e999'").

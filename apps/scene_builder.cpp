@@ -129,7 +129,26 @@ SimulationSetup build_setup(const Scene& scene) {
                                      std::min(1e18, double(setup.position.size()) + object_estimate))) +
                                  " particles with this object (more than " + std::to_string(kMaxSceneParticles) +
                                  "); increase fluid.spacing or scale the object down");
+            const std::size_t first = setup.position.size();
             add_solid_object(setup, mesh, solid, o.velocity, id, r0, scene.params.fluid.support_radius, pinned);
+            // As for static boxes: fluid inside a solid would sit among its boundary particles
+            // and be blown out in the first step. (Carving the fluid out, for submerged bodies,
+            // is for the coupling work.) Geometry particles (GPs) take no part in the fluid.
+            for (std::size_t b = 0; b < scene.fluid_blocks.size(); ++b) {
+                const FluidBlock& block = scene.fluid_blocks[b];
+                const Real margin = Real(0.5) * Real(r0);
+                long inside = 0;
+                for (std::size_t i = first; i < setup.position.size(); ++i) {
+                    const Vec3 x = setup.position[i];
+                    inside += setup.type[i] != kGeometry && x.x > block.min.x + margin && x.x < block.max.x - margin &&
+                              x.y > block.min.y + margin && x.y < block.max.y - margin &&
+                              x.z > block.min.z + margin && x.z < block.max.z - margin;
+                }
+                if (inside > 0)
+                    throw InputError("overlaps fluid_blocks[" + std::to_string(b) + "]: " + std::to_string(inside) +
+                                     " of its particles lie inside the block; an object may touch the fluid but "
+                                     "not overlap it");
+            }
         } catch (const InputError& e) {
             throw InputError(what + ": " + e.what());
         }

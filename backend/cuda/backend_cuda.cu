@@ -126,9 +126,11 @@ StageTimers::~StageTimers() {
         cudaEventDestroy(stop_[s]);
     }
 }
-void StageTimers::start(int stage) { cudaEventRecord(start_[stage]); }
+// One event pair per stage: a stage is timed once between two read()s (each runs once per step).
+// The OpenMP timers add repeated intervals up; these would keep only the last one.
+void StageTimers::start(int stage) { check_cuda(cudaEventRecord(start_[stage]), "StageTimers::start"); }
 void StageTimers::stop(int stage) {
-    cudaEventRecord(stop_[stage]);
+    check_cuda(cudaEventRecord(stop_[stage]), "StageTimers::stop");
     used_[stage] = 1;
 }
 void StageTimers::read(double* ms_out) {

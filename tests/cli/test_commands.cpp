@@ -100,6 +100,38 @@ TEST_CASE("bad input: command line") {
     // A control character in what the user wrote stays escaped: the message is still one line.
     check_rejected(run("info " + tiny() + " --set 'name=\"a\\nb\"'"), {"name", "a\\nb"});
     check_rejected(run("info /dev/zero"), {"/dev/zero", "64 MiB"});
+    check_rejected(run("run " + tiny() + " --time 1e300"), {"--time", "1e+300"});
+    // A domain of 1e9 supports: its cell count once overflowed int and passed the grid check.
+    check_rejected(run("run " + tiny() + " --steps 1 --out " + out_dir("wide") +
+                       " --set 'domain.max=[1e9,0.2,0.2]' --set boundary.walls=false"),
+                   {"domain is too large"});
+    CHECK(!fs::exists(scratch_dir() + "/wide"));
+}
+
+TEST_CASE("bad input: a failed run leaves no directory it made, and no run writes over a directory") {
+    // Every missing level of a nested --out is removed again, not only the last.
+    const std::string nested = out_dir("nested");
+    check_rejected(run("run " + tiny() + " --steps 1 --out " + nested + "/a/b --set 'domain.max=[1e9,0.2,0.2]' "
+                       "--set boundary.walls=false"),
+                   {"domain is too large"});
+    CHECK(!fs::exists(nested));
+    // summary.json is renamed into place at the end: a directory of that name is found first.
+    const std::string taken = out_dir("taken");
+    fs::create_directories(taken + "/summary.json");
+    check_rejected(run("run " + tiny() + " --steps 1 --out " + taken), {"summary.json", "is a directory"});
+    CHECK(!fs::exists(taken + "/stats.csv"));
+    // An object inside the fluid, as a static box there is.
+    const std::string folder = scratch_dir() + "/object_in_fluid";
+    fs::create_directories(folder);
+    write_text(folder + "/scene.json",
+               tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
+                   "transform": {"translation": [0.05, 0.05, 0.05]}}])"));
+    check_rejected(run("info " + folder + "/scene.json"), {"objects[0]", "overlaps fluid_blocks[0]"});
+    // Text that is not UTF-8 (JSON files are checked by the parser; a --set value that is not JSON
+    // is taken as a plain string) fails at once, not after the run when summary.json is written.
+    check_rejected(run("run " + tiny() + " --steps 1 --out " + out_dir("latin1") + " --set 'description=caf\xe9'"),
+                   {"description", "UTF-8"});
+    CHECK(!fs::exists(scratch_dir() + "/latin1"));
 }
 
 TEST_CASE("bad input: a scene larger than the host's memory is refused before allocating") {

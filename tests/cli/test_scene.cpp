@@ -175,6 +175,12 @@ TEST_CASE("bad scenes give one line naming the key") {
         {"static box in the fluid", tiny, {"static_boxes=[{\"min\":[0.02,0,0.02],\"max\":[0.06,0.04,0.06]}]"},
          {"static_boxes[0]", "overlaps fluid_blocks[0]"}},
         {"a name that is a path", tiny, {"name=../../elsewhere"}, {"name", "letters, digits"}},
+        {"duplicate key in a --set value", tiny, {"fluid={\"spacing\":0.04,\"spacing\":0.05}"}, {"--set fluid", "twice"}},
+        {"text that is not UTF-8", tiny, {"description=caf\xe9"}, {"description", "UTF-8"}},
+        {"a NUL in a key stays in the message", tiny_scene_text(R"("output": {"f\u0000ps": 3})"), {},
+         {"output.f\\x00ps", "unknown key"}},
+        {"misspelt mesh key", tiny_scene_text(R"("objects": [{"mesh": {"fiel": "x.obj"}}])"), {},
+         {"objects[0].mesh", "\"fiel\""}},
     };
     for (const Case& c : cases) {
         CAPTURE(c.what);
@@ -184,6 +190,13 @@ TEST_CASE("bad scenes give one line naming the key") {
         CHECK(message.find('\n') == std::string::npos);
         for (const auto& part : c.expect) CHECK(contains(message, part));
     }
+}
+
+TEST_CASE("arrays of blocks, boxes and objects are capped") {
+    std::string blocks;
+    for (int i = 0; i < 10001; ++i) blocks += std::string(i ? "," : "") + R"({"min":[0,0,0],"max":[0.1,0.1,0.1]})";
+    const std::string message = parse_error(tiny_scene_text(), {"fluid_blocks=[" + blocks + "]"});
+    CHECK(contains(message, "at most 10000"));
 }
 
 TEST_CASE("touching fluid blocks and a box beside the fluid are accepted") {
