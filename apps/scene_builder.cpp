@@ -106,10 +106,13 @@ SimulationSetup build_setup(const Scene& scene) {
             // Fluid blocks and static boxes are checked against the domain when the scene is
             // read; an object's extent is known only once its mesh is loaded and transformed.
             // Outside the domain its particles would be clamped onto the walls in the first step.
+            // A mesh touching a face may overshoot it by rounding (OBJ coordinates are read as
+            // float): a thousandth of r0 is allowed.
             const Aabb box = bounding_box(mesh);
+            const double slack = 1e-3 * scene.params.fluid.spacing;
             const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
-            if (box.lo.x() < lo.x || box.lo.y() < lo.y || box.lo.z() < lo.z || box.hi.x() > hi.x ||
-                box.hi.y() > hi.y || box.hi.z() > hi.z) {
+            if (box.lo.x() < lo.x - slack || box.lo.y() < lo.y - slack || box.lo.z() < lo.z - slack ||
+                box.hi.x() > hi.x + slack || box.hi.y() > hi.y + slack || box.hi.z() > hi.z + slack) {
                 char text[320];
                 std::snprintf(text, sizeof text,
                               "the transformed mesh spans [%g, %g] x [%g, %g] x [%g, %g], not inside the domain "
