@@ -168,10 +168,10 @@ class NeighborGrid {
         h = h / cells_per_h;
         shape_.origin = lo;
         shape_.inv_cell = Real(1) / h;
-        // Counted in double first: a domain 1e9 supports long would overflow an int cell count.
-        double cells = 1;
+        // Cells per axis in double first: a domain 1e9 supports long would overflow an int.
         const Real extent[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
-        for (int a = 0; a < 3; ++a) cells *= std::max(1.0, std::ceil(double(extent[a]) / double(h)));
+        double dims[3], cells = 1;
+        for (int a = 0; a < 3; ++a) cells *= dims[a] = std::max(1.0, double(std::ceil(extent[a] / h)));
         if (!(cells * kGroupCount < double(std::uint64_t(1) << 32))) {
             char count_text[32];
             std::snprintf(count_text, sizeof count_text, "%.3g", cells);
@@ -179,11 +179,10 @@ class NeighborGrid {
                              " grid cells (at most about 1.4e9); shrink the domain or enlarge the support radius "
                              "(scene keys domain, fluid.support_radius)");
         }
-        std::uint64_t count = 1;
+        const std::uint64_t count = static_cast<std::uint64_t>(cells);
         int largest = 1;
         for (int a = 0; a < 3; ++a) {
-            shape_.dims[a] = std::max(1, static_cast<int>(std::ceil(extent[a] / h)));
-            count *= static_cast<std::uint64_t>(shape_.dims[a]);
+            shape_.dims[a] = static_cast<int>(dims[a]);
             largest = std::max(largest, shape_.dims[a]);
         }
         shape_.cell_count = static_cast<std::uint32_t>(count);

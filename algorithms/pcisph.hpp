@@ -175,14 +175,17 @@ struct MotionSummaryOp {
                              a.first_bad < b.first_bad ? a.first_bad : b.first_bad};
     }
 };
+// One particle's share; `index` is reported when it is not finite. |v|² overflowing (speeds past
+// ~1e19 m/s in float) counts as not finite: it would make the energy and the CFL step inf.
+MW_INLINE MotionSummary particle_motion(Vec3 x, Vec3 v, Real mass, std::uint32_t index) {
+    const Real v2 = norm2(v);
+    const bool finite = is_finite(v) && is_finite(x) && std::isfinite(v2);
+    return MotionSummary{finite ? 0.5 * double(mass) * double(v2) : 0.0, finite ? v2 : Real(0),
+                         finite ? 0xffffffffu : index};
+}
 inline MotionSummary summarize_motion(std::size_t count, View<const Vec3> position, View<const Vec3> velocity, Real mass) {
     return transform_reduce("motion_summary", count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
-        const Vec3 v = velocity[i];
-        const Real v2 = norm2(v);
-        // |v|² overflowing (speeds past ~1e19 m/s) would make the energy and the CFL step inf.
-        const bool finite = is_finite(v) && is_finite(position[i]) && std::isfinite(v2);
-        return MotionSummary{finite ? 0.5 * double(mass) * double(v2) : 0.0, finite ? v2 : Real(0),
-                             finite ? 0xffffffffu : static_cast<std::uint32_t>(i)};
+        return particle_motion(position[i], velocity[i], mass, static_cast<std::uint32_t>(i));
     });
 }
 

@@ -36,12 +36,7 @@ inline SolidSummary summarize_solids(const LsmData d) {
     const MotionSummary m = transform_reduce(
         "solid_summary", d.ibp_count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t s) {
             const std::uint32_t i = d.store_of_slot[s];
-            const Vec3 v = d.velocity[i];
-            const Real v2 = norm2(v);
-            // As for fluid: |v|² overflowing counts as a blow-up.
-            const bool finite = is_finite(v) && is_finite(d.position[i]) && std::isfinite(v2);
-            return MotionSummary{finite ? 0.5 * double(d.mass[s]) * double(v2) : 0.0, finite ? v2 : Real(0),
-                                 finite ? 0xffffffffu : static_cast<std::uint32_t>(s)};
+            return particle_motion(d.position[i], d.velocity[i], d.mass[s], static_cast<std::uint32_t>(s));
         });
     return SolidSummary{m.kinetic_energy, m.max_speed2, m.first_bad};
 }

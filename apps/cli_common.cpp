@@ -135,6 +135,15 @@ void check_host_memory(const Scene& scene, const std::string& backend, bool host
                           format_bytes(available) + " is available; increase fluid.spacing or shrink the scene");
 }
 
+int threads_option(const cxxopts::ParseResult& args) {
+    if (!args.count("threads")) return 0;
+    constexpr int kMaxThreads = 1024;
+    const int threads = args["threads"].as<int>();
+    if (threads < 1 || threads > kMaxThreads)
+        throw InputError("--threads must be in [1, " + std::to_string(kMaxThreads) + "], got " + std::to_string(threads));
+    return threads;
+}
+
 std::string format_number(double v) {
     char text[32];
     std::snprintf(text, sizeof text, "%g", v);

@@ -43,6 +43,10 @@ std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, cons
 // GPU, where the host keeps only the initial particles and frame buffers.
 void check_host_memory(const Scene& scene, const std::string& backend, bool host_layout);
 
+// The --threads option: 0 when absent, else a count in [1, 1024] (InputError otherwise). Each
+// OpenMP thread reserves a stack, and libgomp crashes when it cannot create tens of thousands.
+int threads_option(const cxxopts::ParseResult& args);
+
 std::string with_thousands(long n);
 std::string format_number(double v);  // %g: 1e+300, 0.02
 std::string format_bytes(double bytes);

@@ -76,13 +76,7 @@ int command_run(int argc, char** argv) {
         end_steps = args["steps"].as<long>();
         if (end_steps < 1) throw InputError("--steps must be at least 1, got " + std::to_string(end_steps));
     }
-    int threads = 0;
-    if (args.count("threads")) {
-        threads = args["threads"].as<int>();
-        // More threads than that is a typo, and libgomp crashes on tens of thousands.
-        if (threads < 1 || threads > 1024)
-            throw InputError("--threads must be in [1, 1024], got " + std::to_string(threads));
-    }
+    const int threads = threads_option(args);
     const bool quiet = args.count("quiet") > 0;
     const StopSignals stop_signals;
 
@@ -107,15 +101,15 @@ int command_run(int argc, char** argv) {
     // Before the simulation is built, so that an unwritable --out fails at once; the directories
     // made here are removed again (if still empty) when the run ends before its first step.
     const std::vector<std::string> created = make_directories(out_dir);
+    const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
     std::unique_ptr<Simulation> sim;
     try {
-        // stats.csv, summary.json and frames/ are renamed into place at the end: something else
-        // by those names would only fail then, after the whole run.
-        for (const char* name : {"stats.csv", "summary.json"})
-            if (std::filesystem::is_directory(out_dir + "/" + name))
-                throw InputError(out_dir + "/" + name + " is a directory; the run writes a file there");
-        if (std::filesystem::exists(out_dir + "/frames") && !std::filesystem::is_directory(out_dir + "/frames"))
-            throw InputError(out_dir + "/frames is a file; the run writes its frames into a directory there");
+        // stats.csv and summary.json are renamed into place at the end: a directory by those
+        // names would only fail then, after the whole run. (A file named frames fails at once,
+        // when the frame writer makes its directory.)
+        for (const std::string& path : {stats_path, summary_path})
+            if (std::filesystem::is_directory(path))
+                throw InputError(path + " is a directory; the run writes a file there");
         sim = create_simulation(setup, backend, threads);
     } catch (...) {
         remove_created_directories(created);
@@ -126,7 +120,6 @@ int command_run(int argc, char** argv) {
         return report_interrupted_setup();
     }
 
-    const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
     remove_earlier_frames(out_dir);
     std::unique_ptr<FrameWriter> frames;
     if (scene.writes_vtu()) {

@@ -42,8 +42,6 @@ Vec3d parse_triple(const std::string& option, const std::string& text, bool allo
     return Vec3d(v[0], v[1], v[2]);
 }
 
-constexpr int kMaxThreads = 1024;
-
 // The --out directory for the lifetime of one `sample` call: created (with any missing parents)
 // and checked writable on construction. Unless keep() is called, the destructor undoes what the
 // call did: it removes the output files once any of them was written (a mix of new and earlier
@@ -131,15 +129,7 @@ int command_sample(int argc, char** argv) {
     const int directions = args["directions"].as<int>();
     if (directions != 0 && directions != 3 && directions != 7 && directions != 13)
         throw InputError("--directions must be 0, 3, 7 or 13");
-    if (args.count("threads")) {
-        // Each OpenMP thread reserves a stack; libgomp crashes when it cannot create the threads
-        // asked for (100000 of them), and no machine this runs on has more than 1024 cores.
-        const int threads = args["threads"].as<int>();
-        if (threads < 1 || threads > kMaxThreads)
-            throw InputError("--threads must be between 1 and " + std::to_string(kMaxThreads) + ", got " +
-                             std::to_string(threads));
-        omp_set_num_threads(threads);
-    }
+    if (const int threads = threads_option(args)) omp_set_num_threads(threads);
     // Start the thread team now: when the system cannot create the threads libgomp exits the
     // process, and that had better happen before the output directory is made. (An empty region
     // would be dropped by the compiler, hence the call.)

@@ -10,10 +10,6 @@
 #include "backend/errors.hpp"
 
 namespace {
-// The error types escape their own messages (mw::printable); other exceptions' messages and the
-// command name are escaped here.
-std::string one_line(const char* text) { return mw::printable(text); }
-
 void print_usage(std::FILE* to) {
     std::fprintf(to,
         "usage: meltwater <command> [options]\n"
@@ -37,16 +33,16 @@ int main(int argc, char** argv) {
         if (command == "backends") return mw::command_backends(argc - 1, argv + 1);
         if (command == "sample") return mw::command_sample(argc - 1, argv + 1);
         std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample)\n",
-                     one_line(command.c_str()).c_str());
+                     mw::printable(command.c_str()).c_str());
         return 2;
     } catch (const mw::InputError& e) {
-        std::fprintf(stderr, "meltwater: error: %s\n", one_line(e.what()).c_str());
+        std::fprintf(stderr, "meltwater: error: %s\n", mw::printable(e.what()).c_str());
         return 2;
     } catch (const mw::DeviceError& e) {
-        std::fprintf(stderr, "meltwater: device error: %s\n", one_line(e.what()).c_str());
+        std::fprintf(stderr, "meltwater: device error: %s\n", mw::printable(e.what()).c_str());
         return 3;
     } catch (const mw::SimulationError& e) {
-        std::fprintf(stderr, "meltwater: simulation failed: %s\n", one_line(e.what()).c_str());
+        std::fprintf(stderr, "meltwater: simulation failed: %s\n", mw::printable(e.what()).c_str());
         return 4;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr,
@@ -54,7 +50,7 @@ int main(int argc, char** argv) {
                      "less; 'meltwater info SCENE' estimates what a scene needs)\n");
         return 3;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "meltwater: error: %s\n", one_line(e.what()).c_str());
+        std::fprintf(stderr, "meltwater: error: %s\n", mw::printable(e.what()).c_str());
         return 1;
     }
 }

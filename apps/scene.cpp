@@ -79,16 +79,14 @@ std::string representable_range() {
            format_number(double(std::numeric_limits<Real>::max())) + ", or 0)";
 }
 
+// JSON text must be UTF-8; nlohmann checks it when it writes a string (as summary.json will).
 bool valid_utf8(const std::string& text) {
-    for (std::size_t i = 0; i < text.size();) {
-        const unsigned char c = static_cast<unsigned char>(text[i]);
-        const int extra = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
-        if (extra < 0 || i + std::size_t(extra) >= text.size() + (extra == 0)) return false;
-        for (int k = 1; k <= extra; ++k)
-            if ((static_cast<unsigned char>(text[i + k]) >> 6) != 0x2) return false;
-        i += 1 + std::size_t(extra);
+    try {
+        (void)SceneJson(text).dump();
+        return true;
+    } catch (const SceneJson::type_error&) {
+        return false;
     }
-    return true;
 }
 
 // Edits (insert, delete, substitute, swap two neighbours) turning a into b: how a misspelt key
@@ -207,7 +205,8 @@ class Section {
         if (v) {
             if (!v->is_string()) fail(key_path(key), "expected a string, got " + type_name(*v));
             value = v->get<std::string>();
-            // JSON text is UTF-8; a Latin-1 byte would only fail when summary.json is written.
+            // A Latin-1 byte (a --set value that is not JSON is taken as plain text) would
+            // otherwise only fail when summary.json is written, after the run.
             if (!valid_utf8(value)) fail(key_path(key), "the text is not valid UTF-8");
         }
         out_[key] = value;
@@ -404,10 +403,15 @@ void read_neighbors(Section s, Scene& scene) {
     s.finish();
 }
 
-// Two boxes share volume (touching faces do not count).
-bool overlap(Vec3 lo_a, Vec3 hi_a, Vec3 lo_b, Vec3 hi_b) {
-    return lo_a.x < hi_b.x && lo_b.x < hi_a.x && lo_a.y < hi_b.y && lo_b.y < hi_a.y && lo_a.z < hi_b.z &&
-           lo_b.z < hi_a.z;
+// Refuses a box [lo, hi] that shares volume with a fluid block read so far (touching faces do
+// not count): particles in one place, or fluid among a solid's boundary particles, have a
+// density far above rest that PCISPH resolves by an explosion.
+void check_clear_of_fluid_blocks(const Section& s, const Scene& scene, Vec3 lo, Vec3 hi, const std::string& rule) {
+    for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k) {
+        const FluidBlock& f = scene.fluid_blocks[k];
+        if (lo.x < f.max.x && f.min.x < hi.x && lo.y < f.max.y && f.min.y < hi.y && lo.z < f.max.z && f.min.z < hi.z)
+            s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " + describe_box(f.min, f.max) + "; " + rule);
+    }
 }
 
 void read_fluid_blocks(Section& root, Scene& scene) {
@@ -418,13 +422,7 @@ void read_fluid_blocks(Section& root, Scene& scene) {
         b.velocity = s.vec3("velocity", std::array<double, 3>{0, 0, 0});
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the block must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
-        // Overlapping blocks would put two particles in one place: a density far above rest
-        // that PCISPH resolves by an explosion.
-        for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k)
-            if (overlap(b.min, b.max, scene.fluid_blocks[k].min, scene.fluid_blocks[k].max))
-                s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " +
-                                     describe_box(scene.fluid_blocks[k].min, scene.fluid_blocks[k].max) +
-                                     "; blocks may touch but not overlap");
+        check_clear_of_fluid_blocks(s, scene, b.min, b.max, "blocks may touch but not overlap");
         scene.fluid_blocks.push_back(b);
     });
 }
@@ -437,12 +435,7 @@ void read_static_boxes(Section& root, Scene& scene) {
         b.layers = s.integer("layers", scene.boundary_layers, 1, 8);
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the box must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
-        // Fluid inside a solid box would sit among its boundary particles and be blown out.
-        for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k)
-            if (overlap(b.min, b.max, scene.fluid_blocks[k].min, scene.fluid_blocks[k].max))
-                s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " +
-                                     describe_box(scene.fluid_blocks[k].min, scene.fluid_blocks[k].max) +
-                                     "; a static box may touch the fluid but not overlap it");
+        check_clear_of_fluid_blocks(s, scene, b.min, b.max, "a static box may touch the fluid but not overlap it");
         scene.static_boxes.push_back(b);
     });
 }
@@ -569,7 +562,6 @@ std::string list_keys(const SceneJson& obj) {
     return s;
 }
 
-// Applies one override to `raw`, after checking that its path names a key of the resolved scene.
 // JSON text parsed as nlohmann does, except that a key given twice in one object is refused,
 // naming the key and where it is (nlohmann keeps the last; in a scene that is almost always an
 // edit gone wrong). Parse errors are nlohmann's exceptions; `source` prefixes the message.
@@ -603,6 +595,7 @@ SceneJson parse_json_refusing_duplicates(const std::string& text, const std::str
     return SceneJson::parse(text, refuse_duplicates);
 }
 
+// Applies one override to `raw`, after checking that its path names a key of the resolved scene.
 void apply_override(SceneJson& raw, const SceneJson& resolved, const std::string& option) {
     const auto eq = option.find('=');
     if (eq == std::string::npos || eq == 0)
@@ -730,11 +723,11 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_fluid_blocks(root, scene);
     read_static_boxes(root, scene);
     read_objects(root, scene);
-    if (scene.fluid_blocks.empty() && scene.objects.empty())
-        root.fail("fluid_blocks",
-                  "at least one fluid block (or one object) is needed" +
-                      (root.misspelling_hint("fluid_blocks").empty() ? root.misspelling_hint("objects")
-                                                                     : root.misspelling_hint("fluid_blocks")));
+    if (scene.fluid_blocks.empty() && scene.objects.empty()) {
+        const std::string hint = root.misspelling_hint("fluid_blocks");
+        root.fail("fluid_blocks", "at least one fluid block (or one object) is needed" +
+                                      (hint.empty() ? root.misspelling_hint("objects") : hint));
+    }
     read_run(root.object("run"), scene);
     read_output(root.object("output"), scene);
     root.finish();

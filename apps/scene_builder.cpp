@@ -33,6 +33,59 @@ void append(SimulationSetup& s, const std::vector<Vec3>& points, Vec3 velocity, 
         s.object.push_back(object);
     }
 }
+
+// Fluid blocks and static boxes are checked against the domain when the scene is read; an
+// object's extent is known only once its mesh is loaded and transformed. Outside the domain its
+// particles would be clamped onto the walls in the first step. A mesh touching a face may
+// overshoot it by rounding (OBJ coordinates are read as float): a thousandth of r0 is allowed.
+void check_object_inside_domain(const Scene& scene, const TriangleMesh& mesh) {
+    const Aabb box = bounding_box(mesh);
+    const double slack = 1e-3 * scene.params.fluid.spacing;
+    const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
+    if (box.lo.x() < lo.x - slack || box.lo.y() < lo.y - slack || box.lo.z() < lo.z - slack ||
+        box.hi.x() > hi.x + slack || box.hi.y() > hi.y + slack || box.hi.z() > hi.z + slack) {
+        char text[320];
+        std::snprintf(text, sizeof text,
+                      "the transformed mesh spans [%g, %g] x [%g, %g] x [%g, %g], not inside the domain "
+                      "[%g, %g] x [%g, %g] x [%g, %g] (see transform)",
+                      box.lo.x(), box.hi.x(), box.lo.y(), box.hi.y(), box.lo.z(), box.hi.z(), double(lo.x),
+                      double(hi.x), double(lo.y), double(hi.y), double(lo.z), double(hi.z));
+        throw InputError(text);
+    }
+}
+
+// Refused before sampling, which would allocate per lattice point: inner particles about
+// volume / r0³, surface particles about area / r0², plus the mesh's vertices.
+void check_object_particle_budget(const Scene& scene, const TriangleMesh& mesh, std::size_t existing) {
+    const double r0 = scene.params.fluid.spacing;
+    const double total = double(existing) + std::fabs(signed_volume(mesh)) / (r0 * r0 * r0) +
+                         surface_area(mesh) / (r0 * r0) + double(mesh.vertex_count());
+    if (total > double(kMaxSceneParticles))
+        throw InputError("the scene would create about " + std::to_string(static_cast<long>(std::min(1e18, total))) +
+                         " particles with this object (more than " + std::to_string(kMaxSceneParticles) +
+                         "); increase fluid.spacing or scale the object down");
+}
+
+// As for static boxes (checked when the scene is read): fluid inside a solid would sit among its
+// boundary particles and be blown out in the first step. The object's particles are
+// setup[first, end); geometry particles (GPs) take no part in the fluid. (Carving the fluid out,
+// for submerged bodies, is for the coupling work.)
+void check_object_clear_of_fluid(const Scene& scene, const SimulationSetup& setup, std::size_t first) {
+    const Real margin = Real(0.5) * scene.params.fluid.spacing;
+    for (std::size_t b = 0; b < scene.fluid_blocks.size(); ++b) {
+        const FluidBlock& block = scene.fluid_blocks[b];
+        long inside = 0;
+        for (std::size_t i = first; i < setup.position.size(); ++i) {
+            const Vec3 x = setup.position[i];
+            inside += setup.type[i] != kGeometry && x.x > block.min.x + margin && x.x < block.max.x - margin &&
+                      x.y > block.min.y + margin && x.y < block.max.y - margin && x.z > block.min.z + margin &&
+                      x.z < block.max.z - margin;
+        }
+        if (inside > 0)
+            throw InputError("overlaps fluid_blocks[" + std::to_string(b) + "]: " + std::to_string(inside) +
+                             " of its particles lie inside the block; an object may touch the fluid but not overlap it");
+    }
+}
 }  // namespace
 
 ParticleEstimate estimate_particles(const Scene& scene) {
@@ -100,60 +153,16 @@ SimulationSetup build_setup(const Scene& scene) {
             pinned = [p, n](const Vec3& x) { return dot(x - p, n) < 0; };
         }
         const std::int32_t id = static_cast<std::int32_t>(scene.static_boxes.size() + k);
-        const std::string what = scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + ")";
         try {
             const TriangleMesh mesh = object_mesh(scene, o);
-            // Fluid blocks and static boxes are checked against the domain when the scene is
-            // read; an object's extent is known only once its mesh is loaded and transformed.
-            // Outside the domain its particles would be clamped onto the walls in the first step.
-            // A mesh touching a face may overshoot it by rounding (OBJ coordinates are read as
-            // float): a thousandth of r0 is allowed.
-            const Aabb box = bounding_box(mesh);
-            const double slack = 1e-3 * scene.params.fluid.spacing;
-            const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
-            if (box.lo.x() < lo.x - slack || box.lo.y() < lo.y - slack || box.lo.z() < lo.z - slack ||
-                box.hi.x() > hi.x + slack || box.hi.y() > hi.y + slack || box.hi.z() > hi.z + slack) {
-                char text[320];
-                std::snprintf(text, sizeof text,
-                              "the transformed mesh spans [%g, %g] x [%g, %g] x [%g, %g], not inside the domain "
-                              "[%g, %g] x [%g, %g] x [%g, %g] (see transform)",
-                              box.lo.x(), box.hi.x(), box.lo.y(), box.hi.y(), box.lo.z(), box.hi.z(), double(lo.x),
-                              double(hi.x), double(lo.y), double(hi.y), double(lo.z), double(hi.z));
-                throw InputError(text);
-            }
-            // Refused before sampling, which would allocate per lattice point: inner particles
-            // about volume / r0³, surface particles about area / r0², plus the mesh's vertices.
-            const double r0 = scene.params.fluid.spacing;
-            const double object_estimate = std::fabs(signed_volume(mesh)) / (r0 * r0 * r0) +
-                                           surface_area(mesh) / (r0 * r0) + double(mesh.vertex_count());
-            if (double(setup.position.size()) + object_estimate > double(kMaxSceneParticles))
-                throw InputError("the scene would create about " +
-                                 std::to_string(static_cast<long>(
-                                     std::min(1e18, double(setup.position.size()) + object_estimate))) +
-                                 " particles with this object (more than " + std::to_string(kMaxSceneParticles) +
-                                 "); increase fluid.spacing or scale the object down");
+            check_object_inside_domain(scene, mesh);
+            check_object_particle_budget(scene, mesh, setup.position.size());
             const std::size_t first = setup.position.size();
-            add_solid_object(setup, mesh, solid, o.velocity, id, r0, scene.params.fluid.support_radius, pinned);
-            // As for static boxes: fluid inside a solid would sit among its boundary particles
-            // and be blown out in the first step. (Carving the fluid out, for submerged bodies,
-            // is for the coupling work.) Geometry particles (GPs) take no part in the fluid.
-            for (std::size_t b = 0; b < scene.fluid_blocks.size(); ++b) {
-                const FluidBlock& block = scene.fluid_blocks[b];
-                const Real margin = Real(0.5) * Real(r0);
-                long inside = 0;
-                for (std::size_t i = first; i < setup.position.size(); ++i) {
-                    const Vec3 x = setup.position[i];
-                    inside += setup.type[i] != kGeometry && x.x > block.min.x + margin && x.x < block.max.x - margin &&
-                              x.y > block.min.y + margin && x.y < block.max.y - margin &&
-                              x.z > block.min.z + margin && x.z < block.max.z - margin;
-                }
-                if (inside > 0)
-                    throw InputError("overlaps fluid_blocks[" + std::to_string(b) + "]: " + std::to_string(inside) +
-                                     " of its particles lie inside the block; an object may touch the fluid but "
-                                     "not overlap it");
-            }
+            add_solid_object(setup, mesh, solid, o.velocity, id, scene.params.fluid.spacing,
+                             scene.params.fluid.support_radius, pinned);
+            check_object_clear_of_fluid(scene, setup, first);
         } catch (const InputError& e) {
-            throw InputError(what + ": " + e.what());
+            throw InputError(scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + "): " + e.what());
         }
         if (static_cast<long>(setup.position.size()) > kMaxSceneParticles)
             throw InputError(scene.source + ": the objects create more than " + std::to_string(kMaxSceneParticles) +

@@ -102,6 +102,7 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
         return "'" + (dir / name).string() + "'";
     };
     const std::string out = " --out '" + (dir / "out").string() + "'";
+    const std::string tet_vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
     const std::string tet = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
     struct Case {
         std::string args, expect;
@@ -127,9 +128,9 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
          "two.obj: vertex 2 has 2 coordinates, a vertex needs x y z (line 2: 'v 1 0')"},
         {write("cut.obj", tet + "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0") + " --spacing 0.1" + out,
          "cut.obj: vertex 4 has 2 coordinates, a vertex needs x y z (line 8: 'v 0 0'); the file ends in this line"},
-        {write("edge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + tet + "f 1 3\n") + " --spacing 0.1" + out,
+        {write("edge.obj", tet_vertices + tet + "f 1 3\n") + " --spacing 0.1" + out,
          "edge.obj: face 5 has 2 corners, a face needs at least 3 (line 9: 'f 1 3')"},
-        {write("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 99999999999\n") +
+        {write("huge.obj", tet_vertices + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 99999999999\n") +
              " --spacing 0.1" + out,
          "huge.obj: face 4 refers to vertex 99999999999, but the file has 4 vertices (line 8"},
         // Spacings and transforms out of range.
@@ -138,11 +139,11 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
         {"box --spacing 0.1 --scale 1e300" + out, "box: the transform (scale 1e+300,1e+300,1e+300"},
         {"box --spacing 0.1 --translate 1e30,0,0" + out, "too far for double precision to resolve it"},
         // A mesh with no inner particle is refused, as `meltwater run` refuses it.
-        {write("small.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + tet) + " --spacing 0.9" + out,
+        {write("small.obj", tet_vertices + tet) + " --spacing 0.9" + out,
          "small.obj: the mesh holds no inner particle at spacing 0.9 (make it larger or decrease --spacing)"},
-        {"box --spacing 0.1 --threads -5" + out, "--threads must be between 1 and 1024, got -5"},
-        {"box --spacing 0.1 --threads 0" + out, "--threads must be between 1 and 1024, got 0"},
-        {"box --spacing 0.1 --threads 100000" + out, "--threads must be between 1 and 1024, got 100000"},
+        {"box --spacing 0.1 --threads -5" + out, "--threads must be in [1, 1024], got -5"},
+        {"box --spacing 0.1 --threads 0" + out, "--threads must be in [1, 1024], got 0"},
+        {"box --spacing 0.1 --threads 100000" + out, "--threads must be in [1, 1024], got 100000"},
     };
     for (const Case& c : cases) {
         const Run r = run_sample(c.args, kGuard);
