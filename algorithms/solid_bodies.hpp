@@ -76,6 +76,7 @@ class SolidBodies {
         regions_begin_.upload(L.ibp_regions_begin);
         regions_end_.upload(L.ibp_regions_end);
         force_.assign(ibp_count_, Vec3{0, 0, 0});
+        displacement_.assign(ibp_count_, Vec3{0, 0, 0});
         mean_rotation_.assign(ibp_count_, mat3_identity());
         region_offsets_.upload(L.region_offsets);
         member_index_.upload(L.member_index);
@@ -90,6 +91,7 @@ class SolidBodies {
         chunk_sums_.resize(L.chunk_begin.size());
         const std::size_t regions = L.region_count();
         rotation_.assign(regions, quat_identity());
+        rotation_matrix_.assign(regions, mat3_identity());
         mean_displacement_.assign(regions, Vec3{0, 0, 0});
         bool any_damping = false;
         for (const auto& o : L.objects) any_damping = any_damping || o.damping_rate > 0;
@@ -156,12 +158,12 @@ class SolidBodies {
 
     std::size_t bytes() const {
         return store_of_slot_.bytes() + rest_.bytes() + mass_.bytes() + split_mass_.bytes() + object_.bytes() +
-               pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() +
+               pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() + displacement_.bytes() +
                mean_rotation_.bytes() + region_offsets_.bytes() + member_index_.bytes() + region_mass_.bytes() +
                region_c0_.bytes() + region_A0_.bytes() + region_inertia_inv_.bytes() + region_object_.bytes() +
                region_chunks_.bytes() + chunk_begin_.bytes() + chunk_region_.bytes() +
                chunk_sums_.bytes() +
-               rotation_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
+               rotation_.bytes() + rotation_matrix_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes();
     }
@@ -180,6 +182,7 @@ class SolidBodies {
         d.regions_begin = regions_begin_.view().data();
         d.regions_end = regions_end_.view().data();
         d.force = force_.view().data();
+        d.displacement = displacement_.view().data();
         d.mean_rotation = mean_rotation_.view().data();
         d.region_count = static_cast<std::uint32_t>(region_mass_.size());
         d.region_offsets = region_offsets_.view().data();
@@ -195,6 +198,7 @@ class SolidBodies {
         d.chunk_region = chunk_region_.view().data();
         d.chunk_sums = chunk_sums_.view().data();
         d.rotation = rotation_.view().data();
+        d.rotation_matrix = rotation_matrix_.view().data();
         d.mean_displacement = mean_displacement_.view().data();
         d.region_velocity = region_velocity_.view().data();
         d.region_omega = region_omega_.view().data();
@@ -232,6 +236,7 @@ class SolidBodies {
     DeviceArray<std::uint8_t> pinned_;
     DeviceArray<std::uint32_t> regions_begin_, regions_end_;
     DeviceArray<Vec3> force_;
+    DeviceArray<Vec3> displacement_;  // u = x - x0 per IBP, rewritten every LSM step
     DeviceArray<Mat3> mean_rotation_;
     DeviceArray<std::uint32_t> region_offsets_, member_index_;
     DeviceArray<Real> region_mass_;
@@ -241,6 +246,7 @@ class SolidBodies {
     DeviceArray<std::uint32_t> region_chunks_, chunk_begin_, chunk_region_;
     DeviceArray<RegionSums> chunk_sums_;
     DeviceArray<Quat> rotation_;
+    DeviceArray<Mat3> rotation_matrix_;
     DeviceArray<Vec3> mean_displacement_, region_velocity_, region_omega_;
     DeviceArray<LsmObjectParams> objects_;
     DeviceArray<Vec3> gp_rest_;

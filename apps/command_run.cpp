@@ -247,13 +247,16 @@ int command_run(int argc, char** argv) {
                      with_thousands(summary.lost_particles).c_str());
     std::error_code ec;
     const std::string shown = std::filesystem::absolute(out_dir, ec).lexically_normal().string();
-    std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, density error avg %.3g%% max %.3g%%, "
-                "%.1f iterations/step)\n",
+    // The fluid's figures mean nothing in a scene without fluid (all zero): say so instead.
+    char fluid_figures[160] = "no fluid";
+    if (summary.particles.by_type[kFluid] > 0)
+        std::snprintf(fluid_figures, sizeof fluid_figures, "density error avg %.3g%% max %.3g%%, %.1f iterations/step",
+                      100 * stats.density_error_avg(), 100 * stats.density_error_max(), stats.iterations_avg());
+    std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",
                 interrupted ? "interrupted after" : "ran", summary.steps, summary.simulated_time, summary.wall_seconds,
-                stats.median_total_ms(), 100 * stats.density_error_avg(), 100 * stats.density_error_max(),
-                stats.iterations_avg());
-    std::printf("meltwater: results in %s (%d frames in frames/, stats.csv, summary.json)\n",
-                ec ? out_dir.c_str() : shown.c_str(), summary.frames);
+                stats.median_total_ms(), fluid_figures);
+    std::printf("meltwater: results in %s (%d frame%s in frames/, stats.csv, summary.json)\n",
+                ec ? out_dir.c_str() : shown.c_str(), summary.frames, summary.frames == 1 ? "" : "s");
     std::fflush(stdout);
     return interrupted ? 130 : 0;
 }
