@@ -33,7 +33,8 @@ int command_info(int argc, char** argv) {
         throw InputError("--backend: expected auto, cuda or openmp, got '" + requested + "'");
     const std::string backend = requested == "auto" ? choose_backend("auto") : requested;
     check_host_memory(scene, backend, true);
-    const SimulationSetup setup = build_setup(scene);
+    long carved_fluid = 0;
+    const SimulationSetup setup = build_setup(scene, &carved_fluid);
     const ParticleCounts counts = count_particles(setup);
     const std::unique_ptr<Simulation> probe = probe_on_host(setup, backend);
     const std::size_t bytes = probe->device_bytes();
@@ -51,6 +52,7 @@ int command_info(int argc, char** argv) {
         for (int t = 0; t < kParticleTypeCount; ++t) p[particle_type_name(t)] = counts.by_type[t];
         p["total"] = counts.total();
         j["particles"] = p;
+        j["fluid_carved"] = carved_fluid;
         j["backend"] = backend;
         j["device_bytes"] = bytes;
         j["bytes_per_particle"] = bytes_per_particle;
@@ -66,6 +68,10 @@ int command_info(int argc, char** argv) {
     for (int t = 0; t < kParticleTypeCount; ++t)
         std::printf(" %s %s |", particle_type_name(t), with_thousands(counts.by_type[t]).c_str());
     std::printf(" total %s\n", with_thousands(counts.total()).c_str());
+    if (carved_fluid > 0)
+        std::printf("carved      %s fluid particles left out where static boxes and objects stand (closer than "
+                    "%g r0 to their particles, or inside a box)\n",
+                    with_thousands(carved_fluid).c_str(), kFluidClearance);
     std::printf("memory      %s on the %s backend (%.0f bytes/particle; its layout, measured on the host)\n",
                 format_bytes(double(bytes)).c_str(), backend.c_str(), bytes_per_particle);
     std::printf("stages     ");

@@ -403,9 +403,9 @@ void read_neighbors(Section s, Scene& scene) {
     s.finish();
 }
 
-// Refuses a box [lo, hi] that shares volume with a fluid block read so far (touching faces do
-// not count): particles in one place, or fluid among a solid's boundary particles, have a
-// density far above rest that PCISPH resolves by an explosion.
+// Refuses a block [lo, hi] that shares volume with a fluid block read so far (touching faces do
+// not count): two lattices in one place have a density far above rest that PCISPH resolves by an
+// explosion. (Static boxes and objects may overlap the fluid: build_setup carves it out.)
 void check_clear_of_fluid_blocks(const Section& s, const Scene& scene, Vec3 lo, Vec3 hi, const std::string& rule) {
     for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k) {
         const FluidBlock& f = scene.fluid_blocks[k];
@@ -435,7 +435,6 @@ void read_static_boxes(Section& root, Scene& scene) {
         b.layers = s.integer("layers", scene.boundary_layers, 1, 8);
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the box must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
-        check_clear_of_fluid_blocks(s, scene, b.min, b.max, "a static box may touch the fluid but not overlap it");
         scene.static_boxes.push_back(b);
     });
 }

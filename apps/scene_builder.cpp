@@ -7,6 +7,7 @@
 
 #include "backend/errors.hpp"
 #include "sampling/box_particles.hpp"
+#include "sampling/kdtree.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/solid_sample.hpp"
@@ -66,26 +67,6 @@ void check_object_particle_budget(const Scene& scene, const TriangleMesh& mesh, 
                          "); increase fluid.spacing or scale the object down");
 }
 
-// As for static boxes (checked when the scene is read): fluid inside a solid would sit among its
-// boundary particles and be blown out in the first step. The object's particles are
-// setup[first, end); geometry particles (GPs) take no part in the fluid. (Carving the fluid out,
-// for submerged bodies, is for the coupling work.)
-void check_object_clear_of_fluid(const Scene& scene, const SimulationSetup& setup, std::size_t first) {
-    const Real margin = Real(0.5) * scene.params.fluid.spacing;
-    for (std::size_t b = 0; b < scene.fluid_blocks.size(); ++b) {
-        const FluidBlock& block = scene.fluid_blocks[b];
-        long inside = 0;
-        for (std::size_t i = first; i < setup.position.size(); ++i) {
-            const Vec3 x = setup.position[i];
-            inside += setup.type[i] != kGeometry && x.x > block.min.x + margin && x.x < block.max.x - margin &&
-                      x.y > block.min.y + margin && x.y < block.max.y - margin && x.z > block.min.z + margin &&
-                      x.z < block.max.z - margin;
-        }
-        if (inside > 0)
-            throw InputError("overlaps fluid_blocks[" + std::to_string(b) + "]: " + std::to_string(inside) +
-                             " of its particles lie inside the block; an object may touch the fluid but not overlap it");
-    }
-}
 }  // namespace
 
 ParticleEstimate estimate_particles(const Scene& scene) {
@@ -103,7 +84,7 @@ long estimate_particle_count(const Scene& scene) {
     return n > 1e18 ? static_cast<long>(1e18) : static_cast<long>(n);
 }
 
-SimulationSetup build_setup(const Scene& scene) {
+SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     const long estimate = estimate_particle_count(scene);
     if (estimate > kMaxSceneParticles)
         throw InputError(scene.source + ": the scene would create about " + std::to_string(estimate) +
@@ -112,6 +93,7 @@ SimulationSetup build_setup(const Scene& scene) {
     SimulationSetup setup;
     setup.params = scene.params;
     const Real r0 = scene.params.fluid.spacing;
+    std::vector<std::size_t> block_end;  // fluid_blocks[i] fills [block_end[i - 1], block_end[i])
     for (std::size_t i = 0; i < scene.fluid_blocks.size(); ++i) {
         const FluidBlock& b = scene.fluid_blocks[i];
         const std::vector<Vec3> points = fill_box_lattice(b.min, b.max, r0);
@@ -119,6 +101,7 @@ SimulationSetup build_setup(const Scene& scene) {
             throw InputError(scene.source + ": fluid_blocks[" + std::to_string(i) +
                              "]: the block is thinner than fluid.spacing on some axis and holds no particle");
         append(setup, points, b.velocity, kFluid, -1);
+        block_end.push_back(setup.position.size());
     }
     const Real rb = scene.boundary_spacing();
     if (scene.walls)
@@ -127,10 +110,13 @@ SimulationSetup build_setup(const Scene& scene) {
                sample_container_walls(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers,
                                       kWallGap * r0),
                Vec3{0, 0, 0}, kStaticBoundary, -1);
+    const std::size_t first_solid = setup.position.size();
+    std::vector<std::pair<Vec3, Vec3>> boxes;
     for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
         const StaticBox& b = scene.static_boxes[i];
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
                static_cast<std::int32_t>(i));
+        boxes.emplace_back(b.min, b.max);
     }
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
         const SceneObject& o = scene.objects[k];
@@ -157,10 +143,8 @@ SimulationSetup build_setup(const Scene& scene) {
             const TriangleMesh mesh = object_mesh(scene, o);
             check_object_inside_domain(scene, mesh);
             check_object_particle_budget(scene, mesh, setup.position.size());
-            const std::size_t first = setup.position.size();
             add_solid_object(setup, mesh, solid, o.velocity, id, scene.params.fluid.spacing,
                              scene.params.fluid.support_radius, pinned);
-            check_object_clear_of_fluid(scene, setup, first);
         } catch (const InputError& e) {
             throw InputError(scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + "): " + e.what());
         }
@@ -168,7 +152,75 @@ SimulationSetup build_setup(const Scene& scene) {
             throw InputError(scene.source + ": the objects create more than " + std::to_string(kMaxSceneParticles) +
                              " particles; increase fluid.spacing");
     }
+    long carved = 0;
+    if (setup.position.size() > first_solid) {
+        const std::vector<std::uint8_t> removed = carve_fluid(setup, Real(kFluidClearance) * r0, boxes, first_solid);
+        std::size_t begin = 0;
+        for (std::size_t i = 0; i < block_end.size(); ++i) {
+            const long block_carved = std::count(removed.begin() + long(begin), removed.begin() + long(block_end[i]), 1);
+            if (block_carved == long(block_end[i] - begin))
+                throw InputError(scene.source + ": fluid_blocks[" + std::to_string(i) +
+                                 "]: static boxes and objects fill the whole block; no fluid particle is left");
+            carved += block_carved;
+            begin = block_end[i];
+        }
+    }
+    if (carved_fluid) *carved_fluid = carved;
     return setup;
+}
+
+std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
+                                      const std::vector<std::pair<Vec3, Vec3>>& boxes, std::size_t first_solid) {
+    const std::size_t n = setup.position.size();
+    std::vector<Vec3d> solid_points;
+    Vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};  // where carving can happen at all
+    auto grow = [&](Vec3 a, Vec3 b) {
+        lo = Vec3{std::min(lo.x, a.x), std::min(lo.y, a.y), std::min(lo.z, a.z)};
+        hi = Vec3{std::max(hi.x, b.x), std::max(hi.y, b.y), std::max(hi.z, b.z)};
+    };
+    for (std::size_t i = first_solid; i < n; ++i) {
+        const std::uint8_t t = setup.type[i];
+        if (t != kStaticBoundary && t != kSurfaceBoundary && t != kInnerBoundary) continue;
+        const Vec3 x = setup.position[i];
+        solid_points.emplace_back(x.x, x.y, x.z);
+        grow(x, x);
+    }
+    for (const auto& [box_lo, box_hi] : boxes) grow(box_lo, box_hi);
+    std::vector<std::uint8_t> removed(n, 0);
+    if (solid_points.empty() && boxes.empty()) return removed;
+    const PointTree tree(solid_points);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 x = setup.position[i];
+        if (setup.type[i] != kFluid || x.x < lo.x - clearance || x.y < lo.y - clearance || x.z < lo.z - clearance ||
+            x.x > hi.x + clearance || x.y > hi.y + clearance || x.z > hi.z + clearance)
+            continue;
+        bool occupied = false;
+        for (const auto& [box_lo, box_hi] : boxes)
+            occupied = occupied || (x.x > box_lo.x && x.y > box_lo.y && x.z > box_lo.z && x.x < box_hi.x &&
+                                    x.y < box_hi.y && x.z < box_hi.z);
+        if (!occupied && !solid_points.empty()) occupied = tree.nearest(Vec3d(x.x, x.y, x.z)).second < clearance;
+        removed[i] = occupied;
+    }
+    // Compact the lists and renumber the solids' references to them.
+    std::vector<std::uint32_t> new_index(n);
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        new_index[i] = static_cast<std::uint32_t>(kept);
+        if (removed[i]) continue;
+        setup.position[kept] = setup.position[i];
+        setup.velocity[kept] = setup.velocity[i];
+        setup.type[kept] = setup.type[i];
+        setup.object[kept] = setup.object[i];
+        ++kept;
+    }
+    setup.position.resize(kept);
+    setup.velocity.resize(kept);
+    setup.type.resize(kept);
+    setup.object.resize(kept);
+    for (SolidSetup& solid : setup.solids)
+        for (std::vector<std::uint32_t>* list : {&solid.ibp, &solid.gp, &solid.sbp})
+            for (std::uint32_t& index : *list) index = new_index[index];
+    return removed;
 }
 
 TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {

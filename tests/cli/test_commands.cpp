@@ -120,13 +120,6 @@ TEST_CASE("bad input: a failed run leaves no directory it made, and no run write
     fs::create_directories(taken + "/summary.json");
     check_rejected(run("run " + tiny() + " --steps 1 --out " + taken), {"summary.json", "is a directory"});
     CHECK(!fs::exists(taken + "/stats.csv"));
-    // An object inside the fluid, as a static box there is.
-    const std::string folder = scratch_dir() + "/object_in_fluid";
-    fs::create_directories(folder);
-    write_text(folder + "/scene.json",
-               tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
-                   "transform": {"translation": [0.05, 0.05, 0.05]}}])"));
-    check_rejected(run("info " + folder + "/scene.json"), {"objects[0]", "overlaps fluid_blocks[0]"});
     // Text that is not UTF-8 (JSON files are checked by the parser; a --set value that is not JSON
     // is taken as a plain string) fails at once, not after the run when summary.json is written.
     check_rejected(run("run " + tiny() + " --steps 1 --out " + out_dir("latin1") + " --set 'description=caf\xe9'"),
@@ -212,6 +205,36 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(jc["backend"] == "cuda");
     CHECK(jo["backend"] == "openmp");
     CHECK(jc["device_bytes"].get<long>() < jo["device_bytes"].get<long>());
+}
+
+TEST_CASE("a static box and an object inside the fluid carve it out, and the run starts at rest") {
+    // The tiny scene's block (125 particles, 0.1 m cube in a corner of the tank) with a static box
+    // standing in one corner of it and an elastic cube in another.
+    const std::string folder = scratch_dir() + "/carved";
+    fs::create_directories(folder);
+    write_text(folder + "/scene.json",
+               tiny_scene_text(R"("static_boxes": [{"min": [0, 0, 0], "max": [0.04, 0.04, 0.04]}],
+                   "objects": [{"mesh": {"procedural": "box:x=0.04,y=0.04,z=0.04"},
+                                "transform": {"translation": [0.08, 0.02, 0.08]}}])"));
+    const Result r = run("info " + folder + "/scene.json --json");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    const long fluid = j["particles"]["fluid"].get<long>(), carved = j["fluid_carved"].get<long>();
+    CHECK(fluid + carved == 125);
+    // Each solid takes the 2 x 2 x 2 lattice points inside it and the layer half a spacing from
+    // its faces: a 3 x 3 x 3 corner of the block each. The two corners share the 3 points at
+    // x = z = 0.05 m: 27 + 27 - 3 = 51 particles.
+    CHECK(carved == 51);
+    CHECK(contains(run("info " + folder + "/scene.json").out, "carved      51 fluid particles"));
+    // Uncarved, the fluid next to the solids started 55% over-dense and the first step blew it
+    // apart; carved, it starts at rest.
+    const std::string out = out_dir("carved_run");
+    const Result started = run("run " + folder + "/scene.json --steps 3 --threads 1 --quiet --out " + out);
+    CAPTURE(started.err);
+    REQUIRE(started.code == 0);
+    const auto summary = read_json(out + "/summary.json");
+    CHECK(summary["density_error"]["max"].get<double>() < 0.03);
 }
 
 TEST_CASE("the resolved scene names mesh files absolutely, so it runs from anywhere") {

@@ -1,7 +1,9 @@
-// Lattice shape matching: polar decomposition, rest state, goals under rigid motion, momentum,
-// the cantilever, stability at the paper's Δt, and the CUDA/OpenMP comparison.
+// Lattice shape matching: polar decomposition, rest state, goals under rigid motion, GPs, SBPs and
+// normals of a spinning body, momentum, free fall, walls and friction, damping, the cantilever,
+// stability at the paper's Δt, and the CUDA/OpenMP comparison.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -29,6 +31,105 @@ double max_abs_diff(const Mat3& a, const Mat3& b) {
         for (int j = 0; j < 3; ++j) m = std::max(m, double(std::fabs(a.m[i][j] - b.m[i][j])));
     return m;
 }
+
+// Host references in double precision, independent of the library's float algebra.
+using V3d = std::array<double, 3>;
+using M3d = std::array<V3d, 3>;  // rows
+V3d d3(Vec3 v) { return {double(v.x), double(v.y), double(v.z)}; }
+V3d operator+(V3d a, V3d b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+V3d operator-(V3d a, V3d b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3d operator*(double s, V3d a) { return {s * a[0], s * a[1], s * a[2]}; }
+double dot3(V3d a, V3d b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double len3(V3d a) { return std::sqrt(dot3(a, a)); }
+V3d cross3(V3d a, V3d b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+V3d operator*(const M3d& m, V3d v) { return {dot3(m[0], v), dot3(m[1], v), dot3(m[2], v)}; }
+M3d identity3() { return {V3d{1, 0, 0}, V3d{0, 1, 0}, V3d{0, 0, 1}}; }
+M3d transpose3(const M3d& a) {
+    M3d t;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) t[i][j] = a[j][i];
+    return t;
+}
+M3d mul3(const M3d& a, const M3d& b) {
+    M3d c{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) c[i][j] += a[i][k] * b[k][j];
+    return c;
+}
+// Inverse by cofactors (a must be invertible).
+M3d inverse3(const M3d& a) {
+    const V3d c0 = cross3(a[1], a[2]), c1 = cross3(a[2], a[0]), c2 = cross3(a[0], a[1]);
+    const double det = dot3(a[0], c0);
+    M3d inv;
+    for (int i = 0; i < 3; ++i) inv[i] = {c0[i] / det, c1[i] / det, c2[i] / det};
+    return inv;
+}
+// Rotation of the polar decomposition of an invertible A by Newton's iteration X <- (X + X^-T)/2,
+// which converges quadratically to the orthogonal factor.
+M3d polar3(M3d x) {
+    for (int it = 0; it < 60; ++it) {
+        const M3d y = transpose3(inverse3(x));
+        double change = 0;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                const double v = 0.5 * (x[i][j] + y[i][j]);
+                change = std::max(change, std::fabs(v - x[i][j]));
+                x[i][j] = v;
+            }
+        if (change < 1e-15) break;
+    }
+    return x;
+}
+// Angle of the rotation a bᵀ (from its axial vector and trace: accurate for small angles too).
+double angle_between(const M3d& a, const M3d& b) {
+    const M3d r = mul3(a, transpose3(b));
+    const double s = 0.5 * len3(V3d{r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]});
+    return std::atan2(s, 0.5 * (r[0][0] + r[1][1] + r[2][2] - 1));
+}
+
+// The best rigid motion x ≈ R (x0 - c0) + c of a set of equal-mass particles (least squares).
+struct RigidFit {
+    V3d c{}, c0{};
+    M3d R = identity3();
+    double residual = 0;  // largest |x - fit(x0)| over the particles
+    V3d operator()(V3d x0) const { return R * (x0 - c0) + c; }
+};
+RigidFit fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& x0, const std::vector<std::uint32_t>& ids) {
+    RigidFit f;
+    for (std::uint32_t i : ids) f.c = f.c + d3(x[i]), f.c0 = f.c0 + d3(x0[i]);
+    f.c = (1.0 / double(ids.size())) * f.c;
+    f.c0 = (1.0 / double(ids.size())) * f.c0;
+    M3d A{};
+    for (std::uint32_t i : ids) {
+        const V3d p = d3(x[i]) - f.c, q = d3(x0[i]) - f.c0;
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) A[a][b] += p[a] * q[b];
+    }
+    f.R = polar3(A);
+    for (std::uint32_t i : ids) f.residual = std::max(f.residual, len3(d3(x[i]) - f(d3(x0[i]))));
+    return f;
+}
+
+// A solid scene run directly on a particle store and SolidBodies (OpenMP, no neighbour sort, so
+// store order = scene order), for what the Simulation interface does not show (SBP normals).
+struct DirectSolids {
+    openmp_backend::ParticleStore store;
+    openmp_backend::SolidBodies bodies;
+    explicit DirectSolids(const SimulationSetup& s) {
+        openmp_backend::set_threads(1);  // as make_openmp: the suite runs beside other jobs on 2 cores
+        const std::size_t n = s.position.size();
+        store.resize(n, n);
+        std::vector<std::uint32_t> order(n);
+        for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
+        store.id.upload(order);
+        store.type.upload(s.type);
+        store.position.upload(s.position);
+        store.velocity.upload(s.velocity);
+        bodies.init(s, order, store);
+        bodies.update_slot_map(store);
+    }
+};
 
 }  // namespace
 
@@ -111,6 +212,159 @@ TEST_CASE("goals reproduce a rigid translation plus rotation of the rest shape")
         for (std::size_t k = 0; k < ids.size(); ++k) err = std::max(err, double(norm(goals[k] - moved[ids[k]])));
         MESSAGE(std::string(kind == SolidKind::kRigid ? "rigid" : "elastic") << ": largest goal error " << err / 0.02 << " r0");
         CHECK(err < 1e-3 * 0.02);  // 1e-3 r0 (float rounding of coordinates near 0.5 m)
+    }
+}
+
+TEST_CASE("spinning rigid body: GPs follow the rigid fit of the IBPs, SBPs their triangles, normals rotate") {
+    // A rigid body (alpha = 1, one region) spinning at 2 rad/s about a tilted axis, no gravity, far
+    // from the walls, for 50 steps of 5 ms (about 0.5 rad). At rest any interpolation is right;
+    // turned by 0.5 rad, Eq. 19 without R would put a GP about 0.5 |o| off, where o = x0_g - Σ W x0_d
+    // is its offset from its IBPs (about r0 at a surface vertex).
+    const Real dt = Real(0.005);
+    const int steps = 50;
+    const double r0 = 0.02;
+    const Vec3 omega = Real(2.0 / std::sqrt(1.0 + 4.0 + 0.25)) * Vec3{1, 2, 0.5f};
+    struct Shape {
+        const char* name;
+        TriangleMesh mesh;
+    };
+    TriangleMesh sphere = make_sphere(0.09, 2);
+    MeshTransform to_centre;
+    to_centre.translation = Vec3d(0.5, 0.5, 0.5);
+    apply_transform(sphere, to_centre);
+    const Shape shapes[] = {{"box", box_mesh(Vec3{0.2f, 0.12f, 0.1f}, Vec3{0.5f, 0.5f, 0.5f})}, {"icosphere", sphere}};
+    for (const Shape& shape : shapes) {
+        CAPTURE(std::string(shape.name));
+        SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, dt, Vec3{0, 0, 0});
+        add(s, shape.mesh, solid(SolidKind::kRigid, 1000, 2, 1));
+        const SolidSetup& body = s.solids[0];
+        const std::vector<std::uint32_t> ids = ibps(s);
+        const RigidFit rest = fit_rigid(s.position, s.position, ids);
+        const Vec3 centre{Real(rest.c0[0]), Real(rest.c0[1]), Real(rest.c0[2])};
+        for (std::size_t i = 0; i < s.position.size(); ++i) s.velocity[i] = cross(omega, s.position[i] - centre);
+        // Each GP's offset o from its IBPs (normalised weights, as the layout normalises them).
+        std::vector<V3d> offset(body.gp.size());
+        std::size_t most_links = 0;
+        for (std::size_t g = 0; g < body.gp.size(); ++g) {
+            double total = 0;
+            V3d mean{0, 0, 0};
+            for (int k = body.gp_offsets[g]; k < body.gp_offsets[g + 1]; ++k) {
+                total += body.gp_weights[std::size_t(k)];
+                mean = mean + double(body.gp_weights[std::size_t(k)]) * d3(s.position[body.ibp[std::size_t(body.gp_links[std::size_t(k)])]]);
+            }
+            offset[g] = d3(s.position[body.gp[g]]) - (1.0 / total) * mean;
+            most_links = std::max(most_links, std::size_t(body.gp_offsets[g + 1] - body.gp_offsets[g]));
+        }
+        // Float rounding of Eq. 19's weighted sum: each of its terms (coordinates below 1 m) rounds
+        // by at most half an ulp, 2^-25 m; a few more for the rotation product.
+        const double sum_rounding = double(most_links + 4) * std::ldexp(1.0, -25);
+        DirectSolids run(s);
+        M3d previous = identity3();  // the start is the rest shape
+        std::vector<Vec3> gp_before(body.gp.size());
+        for (std::size_t g = 0; g < body.gp.size(); ++g) gp_before[g] = s.position[body.gp[g]];
+        double worst_gp = 0, worst_gp_velocity = 0, worst_sbp = 0, worst_sbp_velocity = 0, worst_normal_vs_triangle = 0;
+        double worst_normal = 0, worst_ibp = 0, largest_step_angle = 0, ignored_rotation_error = 0, first_residual = 0;
+        double largest_gp_tolerance = 0, largest_normal_error = 0;
+        RigidFit fit;
+        for (int step = 0; step < steps; ++step) {
+            run.bodies.step(run.store, dt, Vec3{0, 0, 0}, s.params.domain_min, s.params.domain_max);
+            const std::vector<Vec3> x = run.store.position.to_host(), v = run.store.velocity.to_host();
+            const View<const Vec3> normal_view = run.bodies.sbp_normals();
+            const std::vector<Vec3> normal(normal_view.data(), normal_view.data() + normal_view.size());
+            fit = fit_rigid(x, s.position, ids);
+            // The GPs of this step use the region rotation fitted at the start of the step (the
+            // previous fit) and the IBPs after it, so x_g - fit(x0_g) = (R_prev - R) o + Σ W (x_d -
+            // fit(x0_d)): at most |R_prev - R| |o| + the IBPs' own residual + rounding, where
+            // |R_prev - R| is the chord 2 sin(θ/2) <= θ of this step's turn θ.
+            const double step_angle = angle_between(fit.R, previous);
+            largest_step_angle = std::max(largest_step_angle, step_angle);
+            // The IBPs themselves: x_{n+1} = g_n + Δt v_n moves them along the tangent, off the
+            // rigid fit by the sagitta s = r⊥ θ²/2 of a step; the goal's correction -e_n/Δt stays in
+            // the velocity, so the deviation follows e_{n+1} = e_n - e_{n-1} + s, i.e.
+            // 2 s (1 - cos((n + 1) π/3)) from rest: never more than 4 s (2% for ω's slow wander).
+            if (step == 0) {
+                first_residual = fit.residual;
+                double r_max = 0;
+                for (std::uint32_t i : ids) r_max = std::max(r_max, len3(d3(s.position[i]) - rest.c0));
+                // The sagitta r⊥ θ²/2 <= r_max θ²/2, with 2x room for the least-squares spread.
+                CHECK(first_residual < r_max * step_angle * step_angle);
+            }
+            worst_ibp = std::max(worst_ibp, fit.residual / (4.08 * first_residual));
+            std::vector<double> gp_error(body.gp.size());
+            for (std::size_t g = 0; g < body.gp.size(); ++g) {
+                const std::uint32_t i = body.gp[g];
+                gp_error[g] = len3(d3(x[i]) - fit(d3(s.position[i])));
+                const double tolerance = step_angle * len3(offset[g]) + fit.residual + sum_rounding;
+                worst_gp = std::max(worst_gp, gp_error[g] / tolerance);
+                largest_gp_tolerance = std::max(largest_gp_tolerance, tolerance);
+                // GP velocity is this step's displacement over Δt (float: a few ulps of |v|).
+                const V3d displacement_rate = (1.0 / double(dt)) * (d3(x[i]) - d3(gp_before[g]));
+                worst_gp_velocity = std::max(worst_gp_velocity, len3(d3(v[i]) - displacement_rate) / (1e-6 * len3(displacement_rate) + 1e-9));
+                gp_before[g] = x[i];
+            }
+            for (std::size_t k = 0; k < body.sbp.size(); ++k) {
+                const std::array<int, 3>& corner = body.sbp_corners[k];
+                const V3d b = d3(body.sbp_barycentric[k]);
+                V3d xb{0, 0, 0}, vb{0, 0, 0};
+                for (int j = 0; j < 3; ++j) {
+                    xb = xb + b[std::size_t(j)] * d3(x[body.gp[std::size_t(corner[std::size_t(j)])]]);
+                    vb = vb + b[std::size_t(j)] * d3(v[body.gp[std::size_t(corner[std::size_t(j)])]]);
+                }
+                // Three float products and two sums of values below 1 m (or 1 m/s), each rounding
+                // by at most half an ulp, 2^-25: at most 5 · 2^-25 = 1.5e-7.
+                const double combination_rounding = 5 * std::ldexp(1.0, -25);
+                worst_sbp = std::max(worst_sbp, len3(d3(x[body.sbp[k]]) - xb) / combination_rounding);
+                worst_sbp_velocity = std::max(worst_sbp_velocity, len3(d3(v[body.sbp[k]]) - vb) / combination_rounding);
+                // Normal: the deformed triangle's, oriented like the rest normal n0.
+                const V3d c0 = d3(x[body.gp[std::size_t(corner[0])]]), c1 = d3(x[body.gp[std::size_t(corner[1])]]),
+                          c2 = d3(x[body.gp[std::size_t(corner[2])]]);
+                const V3d r0c0 = d3(s.position[body.gp[std::size_t(corner[0])]]), r0c1 = d3(s.position[body.gp[std::size_t(corner[1])]]),
+                          r0c2 = d3(s.position[body.gp[std::size_t(corner[2])]]);
+                const V3d n0 = d3(body.sbp_normal[k]);
+                const V3d rest_cross = cross3(r0c1 - r0c0, r0c2 - r0c0);
+                const double sign = dot3(rest_cross, n0) < 0 ? -1.0 : 1.0;
+                const V3d tri = cross3(c1 - c0, c2 - c0);
+                const V3d tri_normal = (sign / len3(tri)) * tri;
+                const V3d n = d3(normal[k]);
+                // Against the host's normal of the same GPs: float cross product of edges of
+                // 0.02 m to 0.2 m, accurate to about 1e-6 rad.
+                worst_normal_vs_triangle = std::max(worst_normal_vs_triangle, len3(n - tri_normal) / 1e-5);
+                // Against R n0: corners off the rigid fit by e_j turn the normal of edges a = c1 - c0,
+                // b = c2 - c0 by at most (|a| (e2 + e0) + |b| (e1 + e0)) / |a × b| (first order).
+                const double e0 = gp_error[std::size_t(corner[0])], e1 = gp_error[std::size_t(corner[1])],
+                             e2 = gp_error[std::size_t(corner[2])];
+                const double turn = (len3(r0c1 - r0c0) * (e2 + e0) + len3(r0c2 - r0c0) * (e1 + e0)) / len3(rest_cross);
+                const double normal_error = len3(n - fit.R * ((1.0 / len3(n0)) * n0));
+                largest_normal_error = std::max(largest_normal_error, normal_error);
+                worst_normal = std::max(worst_normal, normal_error / (turn + 1e-5));
+            }
+            previous = fit.R;
+        }
+        // How far off Eq. 19 without R would be at the end, per GP: |(R - I) o|.
+        for (std::size_t g = 0; g < body.gp.size(); ++g) {
+            const V3d o = offset[g];
+            ignored_rotation_error = std::max(ignored_rotation_error, len3(fit.R * o - o));
+        }
+        const double turned = angle_between(fit.R, identity3());
+        MESSAGE(std::string(shape.name) << ": " << ids.size() << " IBPs, " << body.gp.size() << " GPs, " << body.sbp.size()
+                << " SBPs; turned " << turned << " rad (largest step " << largest_step_angle << "); worst/tolerance: GP "
+                << worst_gp << ", GP velocity " << worst_gp_velocity << ", SBP " << worst_sbp << ", SBP velocity "
+                << worst_sbp_velocity << ", normal vs its triangle " << worst_normal_vs_triangle << ", normal vs R n0 "
+                << worst_normal << " (largest |n - R n0| " << largest_normal_error << "), IBP residual " << worst_ibp
+                << "; GP tolerance up to " << largest_gp_tolerance / r0 << " r0, without R a GP would be off by "
+                << ignored_rotation_error / r0 << " r0");
+        CHECK(turned > 0.45);  // ω t = 0.5 rad; the tilted axis is not principal, so ω wanders a little
+        CHECK(worst_ibp <= 1);
+        CHECK(worst_gp <= 1);
+        CHECK(worst_gp_velocity <= 1);
+        CHECK(worst_sbp <= 1);
+        CHECK(worst_sbp_velocity <= 1);
+        CHECK(worst_normal_vs_triangle <= 1);
+        CHECK(worst_normal <= 1);
+        // The GP tolerance (largest step angle |o| + residual + rounding) must be far below what
+        // ignoring R would give, or the test would not see that mistake.
+        CHECK(ignored_rotation_error > 10 * largest_gp_tolerance);
+        CHECK(largest_step_angle < 0.02);
     }
 }
 
@@ -204,27 +458,240 @@ TEST_CASE("momentum with no external force: linear within 2e-4, angular within 1
     CHECK(worst_l < 1e-3);
 }
 
-TEST_CASE("damping conserves linear momentum and removes deformation energy") {
-    SimulationSetup s = empty_setup(Vec3{-1, -1, -1}, Vec3{1, 1, 1}, Real(0.005), Vec3{0, 0, 0});
-    add(s, box_mesh(Vec3{0.2f, 0.1f, 0.1f}, Vec3{0, 0, 0}), solid(SolidKind::kElastic, 1000, 1, 0.5f, 5));
+TEST_CASE("free fall: the IBPs' centre of mass follows symplectic Euler exactly until the floor") {
+    // v_{n+1} = v_n + Δt g, x_{n+1} = x_n + Δt v_{n+1} gives y_n = y0 + n Δt vy0 - g Δt² n(n+1)/2
+    // (and x, z linear). Shape matching moves no centre of mass (Σ m̃ (g - x) = 0 over every region),
+    // so only float rounding separates the IBPs' mean from this. Missing gravity would be 1 m off,
+    // halved gravity 0.5 m, and explicit Euler (n(n-1)/2 in place of n(n+1)/2) g Δt² n = 2 cm.
+    const Real dt = Real(0.005);
+    const double g = 9.81, r0 = 0.02, floor_y = 0.5 * r0;  // IBPs stop at domain_min + r0/2
+    const Vec3 v0{0.5f, 1.0f, -0.3f};
+    for (SolidKind kind : {SolidKind::kRigid, SolidKind::kElastic}) {
+        const std::string name = kind == SolidKind::kRigid ? "rigid" : "elastic (w 1, alpha 0.5)";
+        CAPTURE(name);
+        SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, dt, Vec3{0, Real(-g), 0});
+        add(s, box_mesh(Vec3{0.2f, 0.12f, 0.1f}, Vec3{0.3f, 0.7f, 0.5f}), solid(kind, 1000, 1, kind == SolidKind::kRigid ? 1 : 0.5f), v0);
+        const std::vector<std::uint32_t> ids = ibps(s);
+        V3d start{0, 0, 0};
+        double lowest = 1e30;
+        for (std::uint32_t i : ids) start = start + d3(s.position[i]), lowest = std::min(lowest, double(s.position[i].y));
+        start = (1.0 / double(ids.size())) * start;
+        auto sim = make_openmp(s);
+        HostParticles h;
+        double worst = 0, worst_ratio = 0;
+        int n = 0;
+        // Stop one step before the lowest layer would reach the floor margin.
+        auto drop = [&](int k) { return double(k) * double(dt) * double(v0.y) - g * double(dt) * double(dt) * double(k) * double(k + 1) / 2; };
+        while (lowest + drop(n + 2) > floor_y) {
+            sim->step();
+            ++n;
+            sim->download(h);
+            V3d mean{0, 0, 0};
+            double low_now = 1e30;
+            for (std::uint32_t i : ids) mean = mean + d3(h.position[i]), low_now = std::min(low_now, double(h.position[i].y));
+            mean = (1.0 / double(ids.size())) * mean;
+            REQUIRE(low_now > floor_y);  // no wall contact yet
+            const V3d expected{start[0] + n * double(dt) * double(v0.x), start[1] + drop(n), start[2] + n * double(dt) * double(v0.z)};
+            const double error = len3(mean - expected);
+            // Each step's x += Δt v rounds every coordinate (below 1 m) by at most half an ulp,
+            // 2^-25 m, so the mean can be off by n · 2^-25 per axis, √3 n · 2^-25 in all. The
+            // velocity's rounding (v < 4 m/s: 2^-23 m/s per step) adds Δt n² 2^-24 < 2e-9 m here.
+            const double bound = std::sqrt(3.0) * n * std::ldexp(1.0, -25) + double(dt) * n * n * std::ldexp(1.0, -24);
+            worst = std::max(worst, error);
+            worst_ratio = std::max(worst_ratio, error / bound);
+        }
+        MESSAGE(name << ": " << n << " steps of free fall (fell " << -drop(n) << " m), largest centre-of-mass error " << worst
+                     << " m = " << worst_ratio << " of the rounding bound");
+        CHECK(n > 80);
+        CHECK(worst_ratio <= 1);
+    }
+}
+
+TEST_CASE("wall contact: IBPs clamped to the margin r0/2, outward velocity dropped, tangential times (1 - friction) per wall") {
+    // One step of a box in its rest shape (so LSM adds exactly nothing) moving into the corner
+    // x = 0, y = 0, no gravity: the first layer in x and in y crosses the margin in this step, the
+    // second does not. Expected velocities are exact; float keeps them to a rounding or two.
+    const Real dt = Real(0.01), friction = Real(0.3), r0 = Real(0.02), margin = r0 / 2;
+    const Vec3 v0{-0.4f, -0.3f, 0.2f};
+    SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, dt, Vec3{0, 0, 0});
+    SolidSetup body = solid(SolidKind::kRigid, 1000, 2, 1);
+    body.wall_friction = friction;
+    add(s, box_mesh(Vec3{0.1f, 0.1f, 0.1f}, Vec3{0.5f, 0.5f, 0.5f}), body, v0);
+    const std::vector<std::uint32_t> ids = ibps(s);
+    Real min_x = 1, min_y = 1;
+    for (std::uint32_t i : ids) min_x = std::min(min_x, s.position[i].x), min_y = std::min(min_y, s.position[i].y);
+    // First layer 1 mm (x) and 1.5 mm (y) from the margin: it moves 4 mm and 3 mm in the step.
+    const Vec3 shift{margin + Real(0.001) - min_x, margin + Real(0.0015) - min_y, 0};
+    for (Vec3& x : s.position) x += shift;
+    const double keep = 1.0 - double(friction);
+    auto sim = make_openmp(s);
+    sim->step();
+    HostParticles h;
+    sim->download(h);
+    int touching[4] = {0, 0, 0, 0};  // none, x wall, floor, both
+    double worst_velocity = 0, worst_position = 0;
+    for (std::uint32_t i : ids) {
+        const bool at_x = s.position[i].x < min_x + shift.x + r0 / 2, at_y = s.position[i].y < min_y + shift.y + r0 / 2;
+        ++touching[int(at_x) + 2 * int(at_y)];
+        const int walls = int(at_x) + int(at_y);
+        // Normal components into the wall go to 0; every other component is scaled once per wall.
+        const V3d expected_v{at_x ? 0.0 : double(v0.x) * std::pow(keep, walls), at_y ? 0.0 : double(v0.y) * std::pow(keep, walls),
+                             double(v0.z) * std::pow(keep, walls)};
+        const V3d free_x = d3(s.position[i]) + double(dt) * d3(v0);
+        const V3d expected_x{at_x ? double(margin) : free_x[0], at_y ? double(margin) : free_x[1], free_x[2]};
+        worst_velocity = std::max(worst_velocity, len3(d3(h.velocity[i]) - expected_v));
+        worst_position = std::max(worst_position, len3(d3(h.position[i]) - expected_x));
+    }
+    MESSAGE("IBPs free " << touching[0] << ", on the x wall " << touching[1] << ", on the floor " << touching[2] << ", on both "
+                         << touching[3] << "; largest velocity error " << worst_velocity << " m/s, position error " << worst_position << " m");
+    for (int c = 0; c < 4; ++c) CHECK(touching[c] > 0);
+    // Velocities below 0.5 m/s: two or three float products, each off by at most 2^-26 m/s;
+    // positions below 1 m: one product and one sum, each off by at most 2^-25 m (the margin 0.01
+    // is 2e-10 m off in float).
+    CHECK(worst_velocity < 1e-7);
+    CHECK(worst_position < 1e-7);
+}
+
+TEST_CASE("dropped on the floor: the lowest IBPs rest at domain_min.y + r0/2 with zero vertical velocity; friction stops the slide") {
+    // A box dropped flat from 6 cm, sliding at 0.3 m/s; rigid, and elastic with damping. After
+    // 1.2 s every step of the next 0.3 s is checked.
+    const Real dt = Real(0.005), r0 = Real(0.02), friction = Real(0.2);
+    const double g = 9.81, floor_y = 0.5 * double(r0), v0 = 0.3;
+    for (SolidKind kind : {SolidKind::kRigid, SolidKind::kElastic}) {
+        const std::string name = kind == SolidKind::kRigid ? "rigid" : "elastic (w 2, alpha 0.5, damping 5/s)";
+        CAPTURE(name);
+        SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, dt, Vec3{0, Real(-g), 0});
+        SolidSetup body = kind == SolidKind::kRigid ? solid(kind, 1000, 2, 1) : solid(kind, 1000, 2, 0.5f, 5);
+        body.wall_friction = friction;
+        add(s, box_mesh(Vec3{0.2f, 0.1f, 0.12f}, Vec3{0.3f, 0.11f, 0.5f}), body, Vec3{Real(v0), 0, 0});
+        const std::vector<std::uint32_t> ids = ibps(s);
+        double rest_low = 1e30;
+        for (std::uint32_t i : ids) rest_low = std::min(rest_low, double(s.position[i].y));
+        std::vector<std::uint32_t> bottom;
+        for (std::uint32_t i : ids)
+            if (s.position[i].y < rest_low + 0.5 * double(r0)) bottom.push_back(i);
+        auto sim = make_openmp(s);
+        HostParticles h;
+        for (int k = 0; k < 240; ++k) sim->step();
+        const int sampled = 60;
+        int resting_steps = 0;
+        double lift = 0, bottom_vy = 0, lowest = 1e30, mean_vx = 0;
+        for (int k = 0; k < sampled; ++k) {
+            sim->step();
+            sim->download(h);
+            for (std::uint32_t i : ids) lowest = std::min(lowest, double(h.position[i].y)), mean_vx += h.velocity[i].x;
+            bool resting = true;
+            for (std::uint32_t i : bottom) {
+                // The margin is 0.01 in float (2e-10 m off); contact sets the outward velocity to 0.
+                resting = resting && std::fabs(double(h.position[i].y) - floor_y) < 1e-9 && h.velocity[i].y == 0;
+                lift = std::max(lift, double(h.position[i].y) - floor_y);
+                bottom_vy = std::max(bottom_vy, std::fabs(double(h.velocity[i].y)));
+            }
+            resting_steps += resting;
+        }
+        mean_vx /= double(sampled) * double(ids.size());
+        double slide = 0;
+        for (std::uint32_t i : ids) slide += double(h.position[i].x) - double(s.position[i].x);
+        slide /= double(ids.size());
+        // Friction acts at most once per step on the bottom layer (a share b of the IBPs), taking
+        // friction · b of the body's sliding momentum (LSM itself keeps momentum). So the slide is at
+        // least the flight (v0 √(2 drop / g)) plus v0 Δt / (friction b), the sum of the geometric
+        // series; without friction the mean x velocity would stay v0.
+        const double share = double(bottom.size()) / double(ids.size());
+        const double min_slide = v0 * std::sqrt(2 * (rest_low - floor_y) / g) + v0 * double(dt) / (double(friction) * share);
+        MESSAGE(name << ": bottom layer " << bottom.size() << " of " << ids.size() << " IBPs at rest on " << resting_steps << " of "
+                     << sampled << " steps; largest lift " << lift / (g * double(dt) * double(dt)) << " g dt^2, largest |vy| "
+                     << bottom_vy / (g * double(dt)) << " g dt; lowest IBP " << lowest << " m; mean vx " << mean_vx
+                     << " m/s; slid " << slide << " m (at least " << min_slide << " m)");
+        CHECK(lowest >= floor_y - 1e-9);  // never below the margin
+        // At rest (exactly on the margin, vy exactly 0) on most steps. Not on all: LSM's update
+        // leaves the previous step's non-rigid velocity in place (α = 1 removes the offset, not the
+        // velocity), and one step of gravity, g Δt in velocity and g Δt² in position, keeps driving
+        // that residual; it lifts the bottom layer now and then by a few g Δt² (the undamped
+        // residual cycle e_{n+1} = e_n - e_{n-1} + s peaks at 4 s). A real bounce off the floor
+        // would leave at about 1 m/s = 20 g Δt.
+        CHECK(resting_steps >= sampled * 3 / 4);
+        CHECK(lift <= 4 * g * double(dt) * double(dt));
+        CHECK(bottom_vy <= 4 * g * double(dt));
+        CHECK(slide >= min_slide);
+        CHECK(std::fabs(mean_vx) < 0.02 * v0);
+    }
+}
+
+TEST_CASE("damping keeps linear and angular momentum and removes deformation energy") {
+    // A spinning, drifting box with random (deforming) velocities on top; damping k = 5/s for 2 s.
+    const Real dt = Real(0.005), alpha = Real(0.5), damping = Real(5);
+    const int steps = 400;
+    SimulationSetup s = empty_setup(Vec3{-1, -1, -1}, Vec3{1, 1, 1}, dt, Vec3{0, 0, 0});
+    add(s, box_mesh(Vec3{0.2f, 0.1f, 0.1f}, Vec3{0, 0, 0}), solid(SolidKind::kElastic, 1000, 1, alpha, damping));
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);
-    for (auto& v : s.velocity) v = Vec3{0.2f, 0, 0} + Real(0.3) * Vec3{Real(u(rng)), Real(u(rng)), Real(u(rng))};
+    const Vec3 drift{0.2f, -0.1f, 0.05f}, spin{1.0f, -1.5f, 2.0f};
+    for (std::size_t i = 0; i < s.velocity.size(); ++i)
+        s.velocity[i] = drift + cross(spin, s.position[i]) + Real(0.3) * Vec3{Real(u(rng)), Real(u(rng)), Real(u(rng))};
     const std::vector<std::uint32_t> ids = ibps(s);
     const double mass = 1000 * std::pow(0.02, 3);
+    // Kinetic energy not in rigid motion: the total minus P²/2M minus L_cᵀ I_c⁻¹ L_c / 2 about
+    // the centre of mass, the least kinetic energy a body with that P and L can have.
+    auto deformation_energy = [&](const HostParticles& h) {
+        V3d c{0, 0, 0}, p{0, 0, 0};
+        double kinetic = 0;
+        for (std::uint32_t i : ids) {
+            c = c + d3(h.position[i]), p = p + mass * d3(h.velocity[i]);
+            kinetic += 0.5 * mass * dot3(d3(h.velocity[i]), d3(h.velocity[i]));
+        }
+        const double M = mass * double(ids.size());
+        c = (1.0 / double(ids.size())) * c;
+        V3d L{0, 0, 0};
+        M3d I{};
+        for (std::uint32_t i : ids) {
+            const V3d r = d3(h.position[i]) - c;
+            L = L + mass * cross3(r, d3(h.velocity[i]) - (1.0 / M) * p);
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < 3; ++b) I[a][b] += mass * ((a == b ? dot3(r, r) : 0.0) - r[a] * r[b]);
+        }
+        return kinetic - 0.5 * dot3(p, p) / M - 0.5 * dot3(L, inverse3(I) * L);
+    };
     HostParticles h;
     auto sim = make_openmp(s);
     sim->download(h);
     const Momenta m0 = momenta(h, ids, mass, Vec3{0, 0, 0});
-    for (int k = 0; k < 400; ++k) sim->step();
-    sim->download(h);
-    const Momenta m1 = momenta(h, ids, mass, Vec3{0, 0, 0});
-    CHECK(std::fabs(m1.p[0] - m0.p[0]) < 2e-4 * std::fabs(m0.p[0]));
-    // What is left is (nearly) the translation's kinetic energy.
-    const double translation = 0.5 * m0.p[0] * m0.p[0] / (mass * double(ids.size()));
-    MESSAGE("kinetic energy: start " << m0.kinetic << " J, after 2 s " << m1.kinetic << " J, translation " << translation << " J");
-    // (the random start also holds some rigid rotation, which damping keeps)
-    CHECK(m1.kinetic - translation < 0.05 * (m0.kinetic - translation));
+    const double e0 = deformation_energy(h);
+    const double p_scale = std::sqrt(m0.p[0] * m0.p[0] + m0.p[1] * m0.p[1] + m0.p[2] * m0.p[2]);
+    const double l_scale = std::sqrt(m0.l[0] * m0.l[0] + m0.l[1] * m0.l[1] + m0.l[2] * m0.l[2]);
+    double worst_p = 0, worst_l = 0;
+    double window_max[4] = {0, 0, 0, 0};  // largest deformation energy in each 0.5 s
+    for (int k = 0; k < steps; ++k) {
+        sim->step();
+        sim->download(h);
+        const Momenta m = momenta(h, ids, mass, Vec3{0, 0, 0});
+        for (int a = 0; a < 3; ++a) {
+            worst_p = std::max(worst_p, std::fabs(m.p[a] - m0.p[a]) / p_scale);
+            worst_l = std::max(worst_l, std::fabs(m.l[a] - m0.l[a]) / l_scale);
+        }
+        double& w = window_max[k * 4 / steps];
+        w = std::max(w, deformation_energy(h));
+    }
+    // Damping moves each IBP toward its regions' rigid velocities, V_r + ω_r × (x - c_r) with
+    // ω_r = I_r⁻¹ L_r from the rest inertia. A body spinning at ω sits stretched off its goals by
+    // the centripetal correction of a step, ε ≈ (ω Δt)²/α, so I is off by 2ε and damping turns L
+    // by up to k t 2ε: here 7.2e-3 (the drift scales so: measured 4x for 2x the spin, 10x for 10x
+    // k, 5e-5 without damping). On top, 1e-3 as for the undamped LSM (momentum test above).
+    const double turn = double(norm(spin)) * double(dt);
+    const double l_tolerance = 2 * double(damping) * steps * double(dt) * turn * turn / double(alpha) + 1e-3;
+    MESSAGE("relative change over 2 s, largest component: linear momentum " << worst_p << ", angular " << worst_l
+            << " (tolerance " << l_tolerance << "); deformation energy, largest in each 0.5 s: " << window_max[0] / e0 << ", "
+            << window_max[1] / e0 << ", " << window_max[2] / e0 << ", " << window_max[3] / e0 << " of " << e0 << " J");
+    // Linear momentum: every region's damping impulses sum to exactly 0, so only float rounding
+    // is left (as in the undamped momentum test).
+    CHECK(worst_p < 2e-4);
+    CHECK(worst_l < l_tolerance);
+    // Without damping the deformation energy stays near e0/2 and above (it shares with the
+    // elastic potential: measured 0.67 e0 at the end). Damping at k takes it down by up to
+    // e^(-k t) = 0.08 per 0.5 s in modes that are not rigid within a region, more slowly in
+    // whole-body bending; so its envelope falls in every window and ends below 5% of e0.
+    for (int w = 1; w < 4; ++w) CHECK(window_max[w] < window_max[w - 1]);
+    CHECK(window_max[3] < 0.05 * e0);
 }
 
 TEST_CASE("pinned cantilever sags, oscillates, and its period shortens as w or alpha grows") {
@@ -284,7 +751,7 @@ TEST_CASE("no NaN and bounded energy at dt = 0.03 s: densities 100 to 10000, and
 
 TEST_CASE("CUDA against OpenMP: swaying pinned bunny, 100 steps") {
     if (!cuda_backend_info().available) {
-        MESSAGE("skipped: no CUDA device (" << cuda_backend_info().description << ")");
+        MESSAGE("SKIPPED: no CUDA device (" << cuda_backend_info().description << ")");
         return;
     }
     const std::string bunny = std::string(MW_SHARED_DIR) + "/assets/meshes/stanford-bunny.obj";
@@ -298,8 +765,9 @@ TEST_CASE("CUDA against OpenMP: swaying pinned bunny, 100 steps") {
         t.translation = Vec3d(0.5, 0.2, 0.5) - scale * b.center();
         apply_transform(mesh, t);
     } else {
-        MESSAGE("bunny mesh not found; using a sphere");
-        mesh = box_mesh(Vec3{0.2f, 0.2f, 0.2f}, Vec3{0.5f, 0.2f, 0.5f});
+        // A post from y = 0.05 to 0.35 m: the pin (y < 0.1) holds its two lowest layers.
+        MESSAGE("bunny mesh not found; using a box post");
+        mesh = box_mesh(Vec3{0.12f, 0.3f, 0.12f}, Vec3{0.5f, 0.2f, 0.5f});
     }
     SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, Real(0.01), Vec3{-3, -9.81f, 0});
     add(s, mesh, solid(SolidKind::kElastic, 1000, 2, 0.5f), Vec3{0, 0, 0}, [](const Vec3& x) { return x.y < 0.1; });
@@ -309,9 +777,15 @@ TEST_CASE("CUDA against OpenMP: swaying pinned bunny, 100 steps") {
     HostParticles ha, hb;
     a->download(ha);
     b->download(hb);
-    double err = 0;
-    for (std::size_t i = 0; i < s.position.size(); ++i) err = std::max(err, double(norm(ha.position[i] - hb.position[i])));
-    MESSAGE("largest CUDA/OpenMP position difference: " << err / 0.3 << " of the object's size");
+    double err = 0, moved = 0;
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+        err = std::max(err, double(norm(ha.position[i] - hb.position[i])));
+        moved = std::max(moved, double(norm(ha.position[i] - s.position[i])));
+    }
+    MESSAGE("largest CUDA/OpenMP position difference: " << err / 0.3 << " of the object's size; largest OpenMP displacement "
+            << moved << " m");
+    // The comparison means something only if the body moved: 1 cm is 30x the tolerance below.
+    CHECK(moved > 0.01);
     CHECK(err < 1e-4 * 0.3);
 }
 
