@@ -9,6 +9,7 @@
 #include <new>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include <embree3/rtcore.h>
 #include <omp.h>
@@ -73,7 +74,10 @@ public:
         const double diagonal = box.extent().norm();
         reach_ = diagonal > 0 && std::isfinite(diagonal) ? diagonal : 1.0;
         unit_ = std::ldexp(1.0, std::ilogb(reach_));
-        device_ = rtcNewDevice("verbose=0");
+        // Embree builds its tree on its own (TBB) threads, every core by default: held to the
+        // OpenMP thread count, so that `--threads` bounds the whole sampler.
+        const std::string config = "verbose=0,threads=" + std::to_string(omp_get_max_threads());
+        device_ = rtcNewDevice(config.c_str());
         if (!device_) throw std::runtime_error("Embree: cannot create a device");
         scene_ = rtcNewScene(device_);
         rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);

@@ -2,6 +2,9 @@
 // whose outputs are checked (stats.csv, summary.json, frames read back with meshio).
 #include <doctest/doctest.h>
 
+#include <sstream>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -167,6 +170,24 @@ TEST_CASE("backends lists what was compiled") {
     CHECK(contains(r.out, "openmp"));
     CHECK(contains(r.out, "cuda"));
     CHECK(contains(r.out, "--backend auto picks"));
+    // The JSON form against how this build was configured (MW_CUDA_COMPILED from CMake).
+    const Result j = run("backends --json");
+    REQUIRE(j.code == 0);
+    const auto listed = nlohmann::json::parse(j.out);
+    bool saw_cuda = false, saw_openmp = false;
+    for (const auto& b : listed["backends"]) {
+        if (b["name"] == "cuda") {
+            saw_cuda = true;
+            CHECK(b["compiled"].get<bool>() == bool(MW_CUDA_COMPILED));
+        }
+        if (b["name"] == "openmp") {
+            saw_openmp = true;
+            CHECK(b["compiled"].get<bool>());
+            CHECK(b["available"].get<bool>());
+        }
+    }
+    CHECK(saw_cuda);
+    CHECK(saw_openmp);
 }
 
 TEST_CASE("info: the built-in default scene and a small one") {
@@ -188,12 +209,20 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(j["stages"].size() > 0);
     CHECK(j["scene"]["solver"]["eta"].get<double>() == doctest::Approx(0.01));
 
-    // A stage the scene does not need is not listed: viscosity off by default.
+    // A stage the scene does not need is not listed and holds no memory: viscosity is off by
+    // default; switching it on adds the stage and its per-particle acceleration array.
     const Result v = run("info " + tiny() + " --json --set fluid.viscosity=0.01");
     REQUIRE(v.code == 0);
     const auto jv = nlohmann::json::parse(v.out);
-    CHECK(jv["stages"].size() >= j["stages"].size());
-    CHECK(jv["device_bytes"].get<long>() >= j["device_bytes"].get<long>());
+    const auto lists_viscosity = [](const nlohmann::json& stages) {
+        for (const auto& s : stages)
+            if (s == "viscosity") return true;
+        return false;
+    };
+    CHECK(!lists_viscosity(j["stages"]));
+    CHECK(lists_viscosity(jv["stages"]));
+    CHECK(jv["stages"].size() == j["stages"].size() + 1);
+    CHECK(jv["device_bytes"].get<long>() > j["device_bytes"].get<long>());
 
     // --backend picks the layout estimated: CUDA gathers from the grid (no neighbour lists), so
     // it needs less than OpenMP's lists; no GPU is needed to estimate for one.
@@ -235,6 +264,57 @@ TEST_CASE("a static box and an object inside the fluid carve it out, and the run
     REQUIRE(started.code == 0);
     const auto summary = read_json(out + "/summary.json");
     CHECK(summary["density_error"]["max"].get<double>() < 0.03);
+}
+
+TEST_CASE("the cantilever scene: its mesh is written per frame, and the pin holds the left end") {
+    // scenes/cantilever.json end to end: a 0.5 x 0.1 x 0.1 m box beam centred at (0.35, 0.7, 0.2),
+    // IBPs with x < 0.14 pinned (half-space, normal +x). 50 steps of 1 ms: frames at t = 0 and 1/30 s.
+    const std::string dir = out_dir("cantilever");
+    const Result r = run("run " + std::string(MW_SOURCE_DIR) + "/scenes/cantilever.json --steps 50 --threads 1 --quiet --out " + dir);
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(contains(r.out, "no fluid"));
+    const auto read_obj = [](const std::string& path, std::vector<std::array<double, 3>>& v, int& faces) {
+        std::istringstream in(slurp(path));
+        std::string line;
+        faces = 0;
+        while (std::getline(in, line)) {
+            std::istringstream fields(line);
+            std::string tag;
+            fields >> tag;
+            if (tag == "v") {
+                std::array<double, 3> x{};
+                fields >> x[0] >> x[1] >> x[2];
+                v.push_back(x);
+            }
+            faces += tag == "f";
+        }
+    };
+    std::vector<std::array<double, 3>> rest, later;
+    int rest_faces = 0, later_faces = 0;
+    read_obj(dir + "/frames/object_beam_00000.obj", rest, rest_faces);
+    read_obj(dir + "/frames/object_beam_00001.obj", later, later_faces);
+    REQUIRE(rest.size() == 8);
+    REQUIRE(later.size() == 8);
+    CHECK(rest_faces == 12);
+    CHECK(later_faces == 12);
+    // Frame 0 is the transformed mesh: every corner of [0.1, 0.6] x [0.65, 0.75] x [0.15, 0.25].
+    for (const auto& x : rest) {
+        CHECK((std::fabs(x[0] - 0.1) < 1e-6 || std::fabs(x[0] - 0.6) < 1e-6));
+        CHECK((std::fabs(x[1] - 0.65) < 1e-6 || std::fabs(x[1] - 0.75) < 1e-6));
+        CHECK((std::fabs(x[2] - 0.15) < 1e-6 || std::fabs(x[2] - 0.25) < 1e-6));
+    }
+    // The free end sags; the pinned end stays (its corners move only through the unpinned IBPs
+    // within a support radius that Eq. 19 also weighs). A pin of the wrong sign holds the other end.
+    double pinned_end = 0, free_end = 0;
+    for (std::size_t k = 0; k < 8; ++k) {
+        const double moved = std::hypot(later[k][0] - rest[k][0], later[k][1] - rest[k][1], later[k][2] - rest[k][2]);
+        if (rest[k][0] < 0.35) pinned_end = std::max(pinned_end, moved);
+        else free_end = std::max(free_end, moved);
+        if (rest[k][0] > 0.35) CHECK(later[k][1] < rest[k][1] - 1e-3);  // fell by more than 1 mm
+    }
+    MESSAGE("after 1/30 s the free end moved " << free_end << " m, the pinned end " << pinned_end << " m");
+    CHECK(pinned_end < 0.1 * free_end);
 }
 
 TEST_CASE("the resolved scene names mesh files absolutely, so it runs from anywhere") {
@@ -347,7 +427,7 @@ TEST_CASE("a frame reads back with meshio") {
         if (python.empty() && std::system((std::string(candidate) + " -c 'import meshio' >/dev/null 2>&1").c_str()) == 0)
             python = candidate;
     if (python.empty()) {
-        MESSAGE("python3 or meshio is missing: skipped (apt install python3-meshio)");
+        MESSAGE("SKIPPED: python3 or meshio is missing (apt install python3-meshio)");
         return;
     }
     const std::string dir = out_dir("meshio");
@@ -380,7 +460,7 @@ TEST_CASE("guards: a blow-up stops the run naming the step, keeping frame 0 and 
     // was found that overflows double within a few steps (PCISPH is invariant to the scale of the
     // density), so a double-precision build skips this case; the guard itself is the same code.
     if (sizeof(mw::Real) != 4) {
-        MESSAGE("skipped in a double-precision build: no scene value blows it up within 5 steps");
+        MESSAGE("SKIPPED: in a double-precision build no scene value blows it up within 5 steps");
         return;
     }
     const Result r = run("run " + tiny() + " --steps 5 --out " + dir + " --set fluid.rest_density=1e38");

@@ -10,7 +10,7 @@
 namespace {
 bool gpu_present() {
     if (mw::backend_available()) return true;
-    MESSAGE("skipped: no CUDA device found");
+    MESSAGE("SKIPPED: no CUDA device found");
     return false;
 }
 }  // namespace

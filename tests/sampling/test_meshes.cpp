@@ -7,6 +7,7 @@
 #include <string>
 
 #include <doctest/doctest.h>
+#include <unistd.h>
 
 #include "backend/errors.hpp"
 #include "sampling/mesh.hpp"
@@ -119,7 +120,9 @@ TEST_CASE("bad mesh input gives one clear error naming the file and the problem"
     const std::string bad_index = error_of([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "index.obj"); });
     CHECK(bad_index.rfind("index.obj: ", 0) == 0);
     // Via a real file as well (NaN written by a tool).
-    const std::string path = (std::filesystem::temp_directory_path() / "mw_sampling_nan_test.obj").string();
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("mw_sampling_nan_test_" + std::to_string(::getpid()) + ".obj"))
+            .string();
     {
         std::ofstream f(path);
         f << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 inf\n" << tet_faces;

@@ -2,6 +2,7 @@
 // non-zero exit for every kind of bad input.
 #define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
 #include <doctest/doctest.h>
+#include <unistd.h>
 
 #include <sys/wait.h>
 
@@ -45,7 +46,9 @@ std::string read_file(const std::filesystem::path& p) {
 }
 
 std::filesystem::path temp_dir(const std::string& name) {
-    const auto d = std::filesystem::temp_directory_path() / ("mw_sample_cli_" + name);
+    // The process id keeps two builds' suites, run at once, out of each other's files.
+    const auto d = std::filesystem::temp_directory_path() /
+                   ("mw_sample_cli_" + std::to_string(::getpid()) + "_" + name);
     std::filesystem::remove_all(d);
     std::filesystem::create_directories(d);
     return d;
