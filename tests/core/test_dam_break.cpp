@@ -6,8 +6,9 @@
 // by about 11% at T = 2.5, advancing at the experiment's speed from T = 1.8 on. The early lead
 // is the known lag of the experiment's first points (the gate was lifted by hand); wall friction
 // (fluid.wall_viscosity) narrows the later gap but not the early one. So the test asserts: the
-// early front within 10%; the late front speed within 10%; the front never behind the experiment
-// by more than 10% and never ahead by more than 25%.
+// early front's advance Z - 1 at T = 0.41 within 0.03 of the experiment's 0.11; the late front
+// speed within 10%; the front never behind the experiment by more than 10% and never ahead by
+// more than 25%.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -52,7 +53,16 @@ TEST_CASE("dam break surge front follows Martin & Moyce") {
         CHECK(deviation > -0.10);
         CHECK(deviation < 0.25);
     }
-    CHECK(std::fabs(simulated[0] - Z[0]) / Z[0] < 0.10);
+    // The early front, as an advance: the column starts at Z = 1 (its front particle r0/2 inside
+    // x = a), so a ratio test on Z itself would pass a column that never moved (Z = 1.00 is -9.9%).
+    // The experiment's advance at T = 0.41 is 0.11. Allowed: 0.03 in Z, which is the front's
+    // discreteness (the front is a particle centre + r0/2, known to about half a spacing,
+    // r0 / (2a) = 0.025) plus the table's rounding to two decimals (0.005). The sample is taken at
+    // the first step past T = 0.41 (ΔT < 0.01 late), which can only add to the advance, at most
+    // about 0.005 at the early front's dZ/dT ≈ 0.5. Measured: 0.0995 (docs/solver.md: Z = 1.10).
+    const double advance = simulated[0] - 1.0, experiment_advance = Z[0] - 1.0;
+    MESSAGE("front advance at T " << at_T[0] << ": " << advance << " (Martin & Moyce " << experiment_advance << ")");
+    CHECK(std::fabs(advance - experiment_advance) < 0.03);
     const double speed = (simulated[9] - simulated[5]) / (at_T[9] - at_T[5]);
     const double experiment_speed = (Z[9] - Z[5]) / (T[9] - T[5]);
     MESSAGE("front speed dZ/dT for T in [1.83, 2.51]: " << speed << " (Martin & Moyce " << experiment_speed << ")");
