@@ -24,7 +24,7 @@ class BackendSimulation final : public Simulation {
     explicit BackendSimulation(const SimulationSetup& setup);
 
     void step() override {
-        const Real dt = choose_time_step();
+        Real dt = choose_time_step();
 
         // 1. Neighbour search: sort moving particles by cell, permute every field, cell ranges.
         timers_.start(kNeighbors);
@@ -62,14 +62,26 @@ class BackendSimulation final : public Simulation {
 
         // 4. PCISPH: predict, density, pressure, pressure force, until the average density
         //    error is below η (at least min, at most max iterations).
-        int iterations = 0;
+        //    In CFL mode a step whose iteration diverges is tried again from the same state at half
+        //    the step (nothing before the integration has moved a particle): the CFL bound does
+        //    not see a flat impact, where a whole column must stop at once (docs/solver.md).
+        int iterations = 0, retries = 0;
         DensityError error;
         if (has_fluid_) {
             timers_.start(kPcisph);
-            const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
-            error = use_lists_ ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, iterations)
-                               : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, iterations);
+            for (;;) {
+                const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
+                bool diverged = false;
+                error = use_lists_
+                            ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, iterations, diverged)
+                            : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, iterations, diverged);
+                if (!diverged || params_.solver.dt_mode != TimeStepMode::kCfl || retries == kMaxRetries) break;
+                dt *= Real(0.5);
+                ++retries;
+            }
             timers_.stop(kPcisph);
+            // After a retry the next steps start from the step that held and grow back gradually.
+            retry_dt_limit_ = retries > 0 ? double(dt) : std::min(1e300, retry_dt_limit_ * kRetryGrowth);
         }
 
         // 5. Coupling forces on solids go here (they fill solids_.force()).
@@ -97,6 +109,7 @@ class BackendSimulation final : public Simulation {
         if (solid_motion.first_bad != 0xffffffffu)
             report_non_finite(solids_.store_index_of_slot(solid_motion.first_bad), "solid inner particle (IBP)");
         fill_report(dt, iterations, error, fluid_count, motion);
+        report_.retries = retries;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
         report_.solid_max_speed = std::sqrt(double(solid_motion.max_speed2));
     }
@@ -124,12 +137,18 @@ class BackendSimulation final : public Simulation {
     // The PCISPH loop over a neighbourhood (the grid, or this step's lists): predict, density and
     // pressure, error, pressure force; until the average error is below η, and the largest below
     // eta_max when that is set (min/max iterations).
+    // `diverged`: the average error rose to more than twice the lowest it reached in this step
+    // while above η (or, with eta_max, the largest error did, above eta_max). PCISPH's pressure
+    // then overshoots and feeds on itself; iterating on only throws the fluid apart, so the loop
+    // stops there.
     template <class Neighbors>
     DensityError pcisph_iterations(const Neighbors& neighbors, std::size_t fluid_count, const Vec3* nonpressure,
-                                   Real delta, Real dt, int& iterations) {
+                                   Real delta, Real dt, int& iterations, bool& diverged) {
         const SolverParams& solver = params_.solver;
         DensityError error;
         iterations = 0;
+        diverged = false;
+        double lowest_average = 1e300, lowest_peak = 1e300;
         while (iterations < solver.max_iterations) {
             // The first prediction has no pressure acceleration yet (nothing to clear beforehand).
             const bool first = iterations == 0;
@@ -150,6 +169,13 @@ class BackendSimulation final : public Simulation {
             const double average = fluid_count ? error.sum / double(fluid_count) : 0.0;
             const bool peak_ok = solver.eta_max <= 0 || error.max <= solver.eta_max;
             if (average <= solver.eta && peak_ok) break;
+            lowest_average = std::min(lowest_average, average);
+            lowest_peak = std::min(lowest_peak, double(error.max));
+            if ((average > 2 * lowest_average && lowest_average > solver.eta) ||
+                (solver.eta_max > 0 && error.max > 2 * lowest_peak && lowest_peak > solver.eta_max)) {
+                diverged = true;
+                break;
+            }
         }
         return error;
     }
@@ -160,11 +186,17 @@ class BackendSimulation final : public Simulation {
 
     Real choose_time_step() const {
         const SolverParams& solver = params_.solver;
-        if (solver.dt_mode == TimeStepMode::kFixed || last_max_speed_ <= 0) return solver.dt;
+        if (solver.dt_mode == TimeStepMode::kFixed) return solver.dt;
+        const Real largest = static_cast<Real>(std::min(double(solver.dt), retry_dt_limit_));
+        if (last_max_speed_ <= 0) return largest;
         const Real cfl_dt = solver.cfl_number * params_.fluid.spacing / static_cast<Real>(last_max_speed_);
         // The floor never lifts the step above the scene's largest step.
-        return std::max(std::min(solver.dt_min, solver.dt), std::min(solver.dt, cfl_dt));
+        return std::max(std::min(solver.dt_min, largest), std::min(largest, cfl_dt));
     }
+    // Retries of a diverging PCISPH step at half the step (CFL mode): at most 6, down to 1/64 of
+    // the step first chosen; after one, the largest step grows back by a quarter per step.
+    static constexpr int kMaxRetries = 6;
+    static constexpr double kRetryGrowth = 1.25;
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
@@ -228,6 +260,7 @@ class BackendSimulation final : public Simulation {
     double time_ = 0;
     long step_ = 0;
     double last_max_speed_ = 0;
+    double retry_dt_limit_ = 1e300;  // CFL mode: largest step after a retry (grows back)
     StepReport report_;
 };
 

@@ -242,6 +242,12 @@ int command_run(int argc, char** argv) {
         std::rethrow_exception(failure);
     }
 
+    if (stats.retried_steps() > 0)
+        std::fprintf(stderr,
+                     "meltwater: note: %s taken again at a smaller dt because PCISPH diverged (column "
+                     "dt_retries of stats.csv; docs/solver.md, \"Flat impacts\")\n",
+                     (with_thousands(stats.retried_steps()) + (stats.retried_steps() == 1 ? " step was" : " steps were"))
+                         .c_str());
     if (summary.lost_particles > 0)
         std::fprintf(stderr, "meltwater: warning: %s fluid particles left the domain (column lost_particles of stats.csv)\n",
                      with_thousands(summary.lost_particles).c_str());

@@ -57,6 +57,7 @@ class StatsTable {
     double density_error_max() const;  // max over steps of the per-step maximum
     double iterations_avg() const;
     int iterations_max() const;
+    long retried_steps() const { return retried_steps_; }  // steps retried at a smaller dt (CFL mode)
     double sum_total_ms() const;
 
    private:
@@ -65,6 +66,7 @@ class StatsTable {
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]
     std::vector<double> total_ms_, error_avg_, error_max_;
     std::vector<int> iterations_;
+    long retried_steps_ = 0;
 };
 
 struct RunSummary {
