@@ -107,7 +107,7 @@ struct StepReport {
     long step = 0;
     double time = 0;           // simulated time after the step, s
     double dt = 0;             // the step just taken, s
-    int iterations = 0;        // PCISPH iterations
+    int iterations = 0;        // PCISPH iterations, summed over the step's tries (dt_retries)
     double density_error_avg = 0;  // average of max(ρ-ρ0,0)/ρ0 over fluid, last iteration
     double density_error_max = 0;  // maximum of the same
     double max_speed = 0;      // m/s over fluid
@@ -116,6 +116,7 @@ struct StepReport {
     double solid_kinetic_energy = 0;  // J over the IBPs of moving solids
     double solid_max_speed = 0;       // m/s over the same
     int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged
+    bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
     std::vector<double> stage_ms;  // per stage, same order as stage_names(); 0 for a stage not run
     double total_ms = 0;
 };

@@ -65,17 +65,22 @@ class BackendSimulation final : public Simulation {
         //    In CFL mode a step whose iteration diverges is tried again from the same state at half
         //    the step (nothing before the integration has moved a particle): the CFL bound does
         //    not see a flat impact, where a whole column must stop at once (docs/solver.md).
-        int iterations = 0, retries = 0;
+        int iterations = 0, retries = 0;  // iterations: of every try of the step
+        bool diverged = false;
         DensityError error;
         if (has_fluid_) {
             timers_.start(kPcisph);
+            const Real floor = std::min(params_.solver.dt_min, params_.solver.dt);
             for (;;) {
                 const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
-                bool diverged = false;
+                int tried = 0;
                 error = use_lists_
-                            ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, iterations, diverged)
-                            : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, iterations, diverged);
-                if (!diverged || params_.solver.dt_mode != TimeStepMode::kCfl || retries == kMaxRetries) break;
+                            ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, tried, diverged)
+                            : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, tried, diverged);
+                iterations += tried;
+                if (!diverged || params_.solver.dt_mode != TimeStepMode::kCfl || retries == kMaxRetries ||
+                    Real(0.5) * dt < floor)
+                    break;
                 dt *= Real(0.5);
                 ++retries;
             }
@@ -110,6 +115,7 @@ class BackendSimulation final : public Simulation {
             report_non_finite(solids_.store_index_of_slot(solid_motion.first_bad), "solid inner particle (IBP)");
         fill_report(dt, iterations, error, fluid_count, motion);
         report_.retries = retries;
+        report_.diverged = diverged;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
         report_.solid_max_speed = std::sqrt(double(solid_motion.max_speed2));
     }
@@ -194,7 +200,8 @@ class BackendSimulation final : public Simulation {
         return std::max(std::min(solver.dt_min, largest), std::min(largest, cfl_dt));
     }
     // Retries of a diverging PCISPH step at half the step (CFL mode): at most 6, down to 1/64 of
-    // the step first chosen; after one, the largest step grows back by a quarter per step.
+    // the step first chosen and never below min(dt_min, dt); after one, the largest step grows
+    // back by a quarter per step.
     static constexpr int kMaxRetries = 6;
     static constexpr double kRetryGrowth = 1.25;
 

@@ -13,6 +13,7 @@
 #include "apps/run_outputs.hpp"
 #include "apps/scene_builder.hpp"
 #include "apps/atomic_file.hpp"
+#include "backend/backend_registry.hpp"
 #include "backend/errors.hpp"
 
 namespace mw {
@@ -96,6 +97,8 @@ int command_run(int argc, char** argv) {
     if (out_dir.empty()) throw InputError("--out: empty directory name");
 
     check_host_memory(scene, backend, backend == "openmp");
+    // --threads bounds the set-up too: objects are sampled on the host's OpenMP threads.
+    if (backend == "openmp") set_host_threads(threads);
     const SimulationSetup setup = build_setup(scene);
     if (g_interrupted) return report_interrupted_setup();
     // Before the simulation is built, so that an unwritable --out fails at once; the directories
@@ -242,12 +245,17 @@ int command_run(int argc, char** argv) {
         std::rethrow_exception(failure);
     }
 
-    if (stats.retried_steps() > 0)
+    if (stats.retried_steps() > 0 && !quiet)
         std::fprintf(stderr,
                      "meltwater: note: %s taken again at a smaller dt because PCISPH diverged (column "
                      "dt_retries of stats.csv; docs/solver.md, \"Flat impacts\")\n",
                      (with_thousands(stats.retried_steps()) + (stats.retried_steps() == 1 ? " step was" : " steps were"))
                          .c_str());
+    if (stats.diverged_steps() > 0)
+        std::fprintf(stderr,
+                     "meltwater: warning: in %s PCISPH diverged and the step was integrated anyway (column "
+                     "diverged of stats.csv); use a smaller dt, or dt_mode \"cfl\" with solver.eta_max\n",
+                     (with_thousands(stats.diverged_steps()) + (stats.diverged_steps() == 1 ? " step" : " steps")).c_str());
     if (summary.lost_particles > 0)
         std::fprintf(stderr, "meltwater: warning: %s fluid particles left the domain (column lost_particles of stats.csv)\n",
                      with_thousands(summary.lost_particles).c_str());

@@ -107,9 +107,9 @@ StatsTable::StatsTable(std::vector<std::string> stage_names)
 
 void StatsTable::add(const StepReport& r) {
     char buffer[160];
-    std::snprintf(buffer, sizeof buffer, "%ld,%.9g,%.9g,%d,%.6g,%.6g,%.6g,%.6g,%ld,%d", r.step, r.time, r.dt,
+    std::snprintf(buffer, sizeof buffer, "%ld,%.9g,%.9g,%d,%.6g,%.6g,%.6g,%.6g,%ld,%d,%d", r.step, r.time, r.dt,
                   r.iterations, r.density_error_avg, r.density_error_max, r.max_speed, r.kinetic_energy,
-                  r.lost_particles, r.retries);
+                  r.lost_particles, r.retries, r.diverged ? 1 : 0);
     csv_rows_ += buffer;
     for (std::size_t s = 0; s < stages_.size(); ++s) {
         const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
@@ -124,12 +124,13 @@ void StatsTable::add(const StepReport& r) {
     error_max_.push_back(r.density_error_max);
     iterations_.push_back(r.iterations);
     retried_steps_ += r.retries > 0;
+    diverged_steps_ += r.diverged;
 }
 
 std::string StatsTable::header() const {
     std::string h =
         "step,time,dt,iterations,density_error_avg,density_error_max,max_speed,kinetic_energy,lost_particles,"
-        "dt_retries";
+        "dt_retries,diverged";
     for (const auto& s : stages_) h += ",ms_" + s;
     return h + ",ms_total";
 }
@@ -208,6 +209,7 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
                           {"max", finite_or_null(stats.density_error_max())}};
     j["iterations"] = {{"avg", stats.iterations_avg()}, {"max", stats.iterations_max()}};
     j["retried_steps"] = stats.retried_steps();
+    j["diverged_steps"] = stats.diverged_steps();
     j["device_bytes"] = run.device_bytes;
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;

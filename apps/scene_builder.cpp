@@ -198,7 +198,10 @@ std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
         for (const auto& [box_lo, box_hi] : boxes)
             occupied = occupied || (x.x > box_lo.x && x.y > box_lo.y && x.z > box_lo.z && x.x < box_hi.x &&
                                     x.y < box_hi.y && x.z < box_hi.z);
-        if (!occupied && !solid_points.empty()) occupied = tree.nearest(Vec3d(x.x, x.y, x.z)).second < clearance;
+        // A particle exactly `clearance` away stays, whichever way float rounding leans (a
+        // symmetric scene is carved symmetrically).
+        if (!occupied && !solid_points.empty())
+            occupied = tree.nearest(Vec3d(x.x, x.y, x.z)).second < double(clearance) * (1 - 1e-4);
         removed[i] = occupied;
     }
     // Compact the lists and renumber the solids' references to them.

@@ -18,5 +18,7 @@ struct BackendInfo {
 BackendInfo openmp_backend_info();
 BackendInfo cuda_backend_info();
 std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads);
+// Host threads for what runs before a simulation exists (sampling objects); 0 keeps the default.
+void set_host_threads(int threads);
 std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup);
 }  // namespace mw

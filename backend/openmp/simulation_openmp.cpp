@@ -9,6 +9,8 @@ BackendInfo openmp_backend_info() {
     return BackendInfo{"openmp", true, true, openmp_backend::device_description(), openmp_backend::kPrefersNeighborLists};
 }
 
+void set_host_threads(int threads) { openmp_backend::set_threads(threads); }
+
 std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads) {
     openmp_backend::set_threads(threads);
     return std::make_unique<openmp_backend::BackendSimulation>(setup);

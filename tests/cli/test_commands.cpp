@@ -351,8 +351,8 @@ TEST_CASE("run: two steps write frames, stats.csv and summary.json") {
     const std::string csv = slurp(dir + "/stats.csv");
     const std::string header = csv.substr(0, csv.find('\n'));
     for (const char* column : {"step", "time", "dt", "iterations", "density_error_avg", "density_error_max",
-                               "max_speed", "kinetic_energy", "lost_particles", "ms_neighbors", "ms_pcisph",
-                               "ms_total"})
+                               "max_speed", "kinetic_energy", "lost_particles", "dt_retries", "diverged",
+                               "ms_neighbors", "ms_pcisph", "ms_total"})
         CHECK_MESSAGE(contains("," + header + ",", std::string(",") + column + ","), column);
     CHECK(count_lines(csv) == 3);  // header + one row per step
     // Every row has as many values as the header has columns.
@@ -363,7 +363,7 @@ TEST_CASE("run: two steps write frames, stats.csv and summary.json") {
     const auto s = read_json(dir + "/summary.json");
     for (const char* key : {"status", "backend", "device", "steps", "particles", "ms_per_step", "density_error",
                             "bytes_per_particle", "scene", "lost_particles", "simulated_time", "wall_seconds",
-                            "particle_steps_per_second", "iterations"})
+                            "particle_steps_per_second", "iterations", "retried_steps", "diverged_steps"})
         CHECK_MESSAGE(s.contains(key), key);
     CHECK(s["status"] == "completed");
     CHECK(s["backend"] == "openmp");

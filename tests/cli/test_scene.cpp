@@ -49,13 +49,23 @@ TEST_CASE("the shipped scenes resolve and build") {
         const Scene s = load_scene(entry.path().string());
         CHECK(!s.name.empty());
         // A scene whose mesh lives in ../shared is built only where that folder is.
-        if (name == "pinned_bunny.json" && !std::filesystem::exists(bunny)) continue;
+        bool meshes_present = true;
+        for (const SceneObject& o : s.objects) {
+            std::filesystem::path mesh(o.mesh_file);
+            if (mesh.is_relative()) mesh = std::filesystem::path(s.base_dir) / mesh;  // as object_mesh() does
+            meshes_present = meshes_present && (o.mesh_file.empty() || std::filesystem::exists(mesh));
+        }
+        if (!meshes_present) {
+            MESSAGE(name << ": its mesh is absent (the shared meshes live in ../shared/assets/meshes), not built");
+            continue;
+        }
         const ParticleCounts c = count_particles(build_setup(s));
         CHECK(c.total() > 0);
         CHECK(c.by_type[kFluid] + c.by_type[kInnerBoundary] > 0);  // something moves
         ++built;
     }
-    CHECK(built >= 5);
+    // All six where ../shared is present (the two mesh scenes need it).
+    CHECK(built >= (std::filesystem::exists(bunny) ? 6 : 4));
     const Scene block = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/splishsplash_block.json");
     CHECK(count_particles(build_setup(block)).by_type[kFluid] == 6859);
 }
@@ -239,7 +249,7 @@ TEST_CASE("static boxes and objects carve the fluid: none is left inside them or
         inside_box += f.x > 0.03f && f.x < 0.07f && f.y < 0.05f && f.z > 0.03f && f.z < 0.07f;
     }
     CHECK(inside_box == 0);
-    CHECK(nearest >= kFluidClearance * r0);
+    CHECK(nearest >= kFluidClearance * r0 * (1 - 1e-4));  // exactly r0 stays, up to rounding
     // The solids' particle lists still name their own particles after the fluid was compacted.
     REQUIRE(setup.solids.size() == 1);  // objects only: static boxes are plain boundary particles
     const SolidSetup& sphere = setup.solids[0];
