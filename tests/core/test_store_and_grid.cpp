@@ -243,6 +243,7 @@ TEST_CASE("neighbour lists refuse a layout their 32-bit offsets cannot address")
     CHECK_THROWS_AS(NeighborList::check_slots(0x100000000ull), DeviceError);
     try {
         NeighborList::check_slots(5000000000ull);
+        FAIL_CHECK("5e9 slots were accepted");
     } catch (const DeviceError& e) {
         const std::string message = e.what();
         CHECK(message.find("5000000000") != std::string::npos);
