@@ -9,13 +9,12 @@
 #include <string>
 #include <vector>
 
-#include <omp.h>
-
 #include "algorithms/particle_types.hpp"
 #include "apps/atomic_file.hpp"
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "apps/vtu_writer.hpp"
+#include "backend/backend_registry.hpp"
 #include "backend/errors.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
@@ -129,17 +128,8 @@ int command_sample(int argc, char** argv) {
     const int directions = args["directions"].as<int>();
     if (directions != 0 && directions != 3 && directions != 7 && directions != 13)
         throw InputError("--directions must be 0, 3, 7 or 13");
-    if (const int threads = threads_option(args)) omp_set_num_threads(threads);
-    // Start the thread team now: when the system cannot create the threads libgomp exits the
-    // process, and that had better happen before the output directory is made. (An empty region
-    // would be dropped by the compiler, hence the call.)
-    int team = 0;
-#pragma omp parallel
-    {
-#pragma omp single
-        team = omp_get_num_threads();
-    }
-    (void)team;
+    // Before the output directory is made: see set_host_threads.
+    set_host_threads(threads_option(args));
     const std::string out_dir = args["out"].as<std::string>();
     if (out_dir.empty()) throw InputError("--out: empty directory name");
 

@@ -406,11 +406,12 @@ void read_neighbors(Section s, Scene& scene) {
 // Refuses a block [lo, hi] that shares volume with a fluid block read so far (touching faces do
 // not count): two lattices in one place have a density far above rest that PCISPH resolves by an
 // explosion. (Static boxes and objects may overlap the fluid: build_setup carves it out.)
-void check_clear_of_fluid_blocks(const Section& s, const Scene& scene, Vec3 lo, Vec3 hi, const std::string& rule) {
+void check_clear_of_fluid_blocks(const Section& s, const Scene& scene, Vec3 lo, Vec3 hi) {
     for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k) {
         const FluidBlock& f = scene.fluid_blocks[k];
         if (lo.x < f.max.x && f.min.x < hi.x && lo.y < f.max.y && f.min.y < hi.y && lo.z < f.max.z && f.min.z < hi.z)
-            s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " + describe_box(f.min, f.max) + "; " + rule);
+            s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " + describe_box(f.min, f.max) +
+                                 "; blocks may touch but not overlap");
     }
 }
 
@@ -422,7 +423,7 @@ void read_fluid_blocks(Section& root, Scene& scene) {
         b.velocity = s.vec3("velocity", std::array<double, 3>{0, 0, 0});
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the block must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
-        check_clear_of_fluid_blocks(s, scene, b.min, b.max, "blocks may touch but not overlap");
+        check_clear_of_fluid_blocks(s, scene, b.min, b.max);
         scene.fluid_blocks.push_back(b);
     });
 }

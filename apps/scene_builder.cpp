@@ -111,12 +111,12 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                                       kWallGap * r0),
                Vec3{0, 0, 0}, kStaticBoundary, -1);
     const std::size_t first_solid = setup.position.size();
-    std::vector<std::pair<Vec3, Vec3>> boxes;
+    std::vector<Eigen::AlignedBox3d> boxes;
     for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
         const StaticBox& b = scene.static_boxes[i];
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
                static_cast<std::int32_t>(i));
-        boxes.emplace_back(b.min, b.max);
+        boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
         const SceneObject& o = scene.objects[k];
@@ -170,38 +170,31 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
 }
 
 std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
-                                      const std::vector<std::pair<Vec3, Vec3>>& boxes, std::size_t first_solid) {
+                                      const std::vector<Eigen::AlignedBox3d>& boxes, std::size_t first_solid) {
     const std::size_t n = setup.position.size();
+    const auto to_vec3d = [](Vec3 x) { return Vec3d(x.x, x.y, x.z); };
     std::vector<Vec3d> solid_points;
-    Vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};  // where carving can happen at all
-    auto grow = [&](Vec3 a, Vec3 b) {
-        lo = Vec3{std::min(lo.x, a.x), std::min(lo.y, a.y), std::min(lo.z, a.z)};
-        hi = Vec3{std::max(hi.x, b.x), std::max(hi.y, b.y), std::max(hi.z, b.z)};
-    };
+    Eigen::AlignedBox3d reach;  // where carving can happen at all (empty to start with)
     for (std::size_t i = first_solid; i < n; ++i) {
         const std::uint8_t t = setup.type[i];
         if (t != kStaticBoundary && t != kSurfaceBoundary && t != kInnerBoundary) continue;
-        const Vec3 x = setup.position[i];
-        solid_points.emplace_back(x.x, x.y, x.z);
-        grow(x, x);
+        solid_points.push_back(to_vec3d(setup.position[i]));
+        reach.extend(solid_points.back());
     }
-    for (const auto& [box_lo, box_hi] : boxes) grow(box_lo, box_hi);
+    for (const Eigen::AlignedBox3d& box : boxes) reach.extend(box);
     std::vector<std::uint8_t> removed(n, 0);
-    if (solid_points.empty() && boxes.empty()) return removed;
+    if (reach.isEmpty()) return removed;
+    reach.min().array() -= clearance;
+    reach.max().array() += clearance;
     const PointTree tree(solid_points);
     for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 x = setup.position[i];
-        if (setup.type[i] != kFluid || x.x < lo.x - clearance || x.y < lo.y - clearance || x.z < lo.z - clearance ||
-            x.x > hi.x + clearance || x.y > hi.y + clearance || x.z > hi.z + clearance)
-            continue;
+        const Vec3d x = to_vec3d(setup.position[i]);
+        if (setup.type[i] != kFluid || !reach.contains(x)) continue;
         bool occupied = false;
-        for (const auto& [box_lo, box_hi] : boxes)
-            occupied = occupied || (x.x > box_lo.x && x.y > box_lo.y && x.z > box_lo.z && x.x < box_hi.x &&
-                                    x.y < box_hi.y && x.z < box_hi.z);
+        for (const Eigen::AlignedBox3d& box : boxes) occupied = occupied || box.contains(x);
         // A particle exactly `clearance` away stays, whichever way float rounding leans (a
         // symmetric scene is carved symmetrically).
-        if (!occupied && !solid_points.empty())
-            occupied = tree.nearest(Vec3d(x.x, x.y, x.z)).second < double(clearance) * (1 - 1e-4);
+        if (!occupied && !solid_points.empty()) occupied = tree.nearest(x).second < double(clearance) * (1 - 1e-4);
         removed[i] = occupied;
     }
     // Compact the lists and renumber the solids' references to them.

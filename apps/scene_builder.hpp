@@ -3,6 +3,8 @@
 #pragma once
 #include <functional>
 
+#include <Eigen/Geometry>
+
 #include "algorithms/simulation.hpp"
 #include "apps/scene.hpp"
 #include "sampling/mesh.hpp"
@@ -37,7 +39,7 @@ constexpr double kFluidClearance = 1.0;
 // before first_solid, sit kWallGap r0 outside the domain and never come that close). Indices in
 // setup.solids are renumbered. Returns, for every particle before the call, whether it was removed.
 std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
-                                      const std::vector<std::pair<Vec3, Vec3>>& boxes, std::size_t first_solid);
+                                      const std::vector<Eigen::AlignedBox3d>& boxes, std::size_t first_solid);
 
 // Samples `mesh` (already in world coordinates) at spacing r0 and support h and appends the object
 // to `setup`: its IBPs, SBPs and GPs as particles (static objects: IBPs and SBPs as static boundary

@@ -19,6 +19,8 @@ BackendInfo openmp_backend_info();
 BackendInfo cuda_backend_info();
 std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads);
 // Host threads for what runs before a simulation exists (sampling objects); 0 keeps the default.
+// Starts the thread team at once: when the system cannot create the threads, libgomp ends the
+// process, and that had better happen before any output is made.
 void set_host_threads(int threads);
 std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup);
 }  // namespace mw

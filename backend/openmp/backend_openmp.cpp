@@ -14,6 +14,17 @@ void set_threads(int threads) {
 
 int thread_count() { return omp_get_max_threads(); }
 
+void start_thread_team() {
+    // An empty region would be dropped by the compiler, hence the call inside.
+    int team = 0;
+#pragma omp parallel
+    {
+#pragma omp single
+        team = omp_get_num_threads();
+    }
+    (void)team;
+}
+
 bool backend_available() { return true; }
 
 static std::string cpu_model() {

@@ -38,6 +38,7 @@ inline MemoryLedger& memory_ledger() {
 }
 
 void set_threads(int threads);        // 0 keeps the OpenMP default
+void start_thread_team();             // creates the threads now (libgomp exits if it cannot)
 int thread_count();
 bool backend_available();             // always true on the CPU
 std::string device_description();     // e.g. "2 OpenMP threads on Intel Xeon ..."

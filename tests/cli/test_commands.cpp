@@ -2,8 +2,6 @@
 // whose outputs are checked (stats.csv, summary.json, frames read back with meshio).
 #include <doctest/doctest.h>
 
-#include <sstream>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +10,7 @@
 
 #include "backend/config.hpp"
 #include "cli_helpers.hpp"
+#include "sampling/obj_loader.hpp"
 
 using namespace cli_test;
 namespace fs = std::filesystem;
@@ -274,30 +273,15 @@ TEST_CASE("the cantilever scene: its mesh is written per frame, and the pin hold
     CAPTURE(r.err);
     REQUIRE(r.code == 0);
     CHECK(contains(r.out, "no fluid"));
-    const auto read_obj = [](const std::string& path, std::vector<std::array<double, 3>>& v, int& faces) {
-        std::istringstream in(slurp(path));
-        std::string line;
-        faces = 0;
-        while (std::getline(in, line)) {
-            std::istringstream fields(line);
-            std::string tag;
-            fields >> tag;
-            if (tag == "v") {
-                std::array<double, 3> x{};
-                fields >> x[0] >> x[1] >> x[2];
-                v.push_back(x);
-            }
-            faces += tag == "f";
-        }
-    };
-    std::vector<std::array<double, 3>> rest, later;
-    int rest_faces = 0, later_faces = 0;
-    read_obj(dir + "/frames/object_beam_00000.obj", rest, rest_faces);
-    read_obj(dir + "/frames/object_beam_00001.obj", later, later_faces);
+    // Read back with the project's own OBJ reader (which also checks the faces' indices).
+    const mw::TriangleMesh rest_mesh = mw::load_obj(dir + "/frames/object_beam_00000.obj");
+    const mw::TriangleMesh later_mesh = mw::load_obj(dir + "/frames/object_beam_00001.obj");
+    const std::vector<mw::Vec3d>& rest = rest_mesh.vertices;
+    const std::vector<mw::Vec3d>& later = later_mesh.vertices;
     REQUIRE(rest.size() == 8);
     REQUIRE(later.size() == 8);
-    CHECK(rest_faces == 12);
-    CHECK(later_faces == 12);
+    CHECK(rest_mesh.triangle_count() == 12);
+    CHECK(later_mesh.triangle_count() == 12);
     // Frame 0 is the transformed mesh: every corner of [0.1, 0.6] x [0.65, 0.75] x [0.15, 0.25].
     for (const auto& x : rest) {
         CHECK((std::fabs(x[0] - 0.1) < 1e-6 || std::fabs(x[0] - 0.6) < 1e-6));
@@ -308,7 +292,7 @@ TEST_CASE("the cantilever scene: its mesh is written per frame, and the pin hold
     // within a support radius that Eq. 19 also weighs). A pin of the wrong sign holds the other end.
     double pinned_end = 0, free_end = 0;
     for (std::size_t k = 0; k < 8; ++k) {
-        const double moved = std::hypot(later[k][0] - rest[k][0], later[k][1] - rest[k][1], later[k][2] - rest[k][2]);
+        const double moved = (later[k] - rest[k]).norm();
         if (rest[k][0] < 0.35) pinned_end = std::max(pinned_end, moved);
         else free_end = std::max(free_end, moved);
         if (rest[k][0] > 0.35) CHECK(later[k][1] < rest[k][1] - 1e-3);  // fell by more than 1 mm

@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <string>
 
 #include "algorithms/sph_kernels.hpp"
@@ -78,9 +77,8 @@ TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydros
         CHECK(std::find(stages.begin(), stages.end(), "solid_volumes") != stages.end());
         CHECK(std::find(stages.begin(), stages.end(), "lsm") != stages.end());
 
-        // 0.7 s; dt = 1 ms because the carved layer leaves a 0.4 r0
-        // drop, and PCISPH does not survive the flat impact of the whole column at dt = 2 ms
-        // (docs/solver.md, "Flat impacts").
+        // 0.7 s; dt = 1 ms because the carved layer leaves a 0.4 r0 drop, and PCISPH does not
+        // survive the flat impact of the whole column at dt = 2 ms (docs/solver.md, "Flat impacts").
         const int steps = 700, averaged = 50;
         const CubicSpline3D kernel = CubicSpline3D::with_support(2 * r0);
         double worst_avg_error = 0, lowest_fluid = 1e9;
@@ -94,21 +92,7 @@ TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydros
                 if (p.type[i] == kFluid) lowest_fluid = std::min(lowest_fluid, double(p.position[i].y));
             if (step < steps - averaged) continue;
             worst_avg_error = std::max(worst_avg_error, sim->last_report().density_error_avg);
-            smoothed_sum.resize(p.position.size(), 0.0);
-            std::vector<std::size_t> fluid;
-            for (std::size_t i = 0; i < p.position.size(); ++i)
-                if (p.type[i] == kFluid) fluid.push_back(i);
-            for (std::size_t i : fluid) {
-                double num = 0, den = 0;
-                for (std::size_t j : fluid) {
-                    const Real r = norm(p.position[i] - p.position[j]);
-                    if (r >= kernel.h) continue;
-                    const double w = kernel.W(r) / p.density[j];
-                    num += w * p.pressure[j];
-                    den += w;
-                }
-                smoothed_sum[i] += num / den;
-            }
+            test::add_smoothed_pressure(p, kernel, smoothed_sum);
         }
         CHECK(worst_avg_error < scene.setup.params.solver.eta);
         // Pinned: the slab's particles never moved (IBPs exactly; SBPs follow them exactly).
@@ -130,20 +114,11 @@ TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydros
         const double expected_depth = double(scene.fluid_count) * r0 * r0 * r0 / (width * width);
         CHECK(depth == doctest::Approx(expected_depth).epsilon(0.03));
 
-        std::map<int, std::pair<double, int>> layers;  // layer -> (sum of relative deviation, count)
-        for (std::size_t i = 0; i < p.position.size(); ++i) {
-            const Vec3 x = p.position[i];
-            if (p.type[i] != kFluid || x.x < margin || x.x > width - margin || x.z < margin || x.z > width - margin ||
-                x.y < slab_top + margin || x.y > H - margin)
-                continue;
-            const double deviation = (smoothed_sum[i] / averaged - rho_g * (H - x.y)) / (rho_g * depth);
-            auto& layer = layers[int((x.y - slab_top) / r0)];
-            layer.first += deviation;
-            ++layer.second;
-        }
-        REQUIRE(layers.size() >= 8);
-        double worst_layer = 0;
-        for (const auto& [index, sum] : layers) worst_layer = std::max(worst_layer, std::fabs(sum.first / sum.second));
+        const test::HydrostaticProfile profile = test::hydrostatic_profile(
+            p, smoothed_sum, averaged, rho_g, slab_top, H, r0, Vec3{Real(margin), Real(slab_top + margin), Real(margin)},
+            Vec3{Real(width - margin), Real(H - margin), Real(width - margin)});
+        REQUIRE(profile.layers >= 8);
+        const double worst_layer = profile.worst_layer;
         MESSAGE("depth " << depth << " m; worst layer deviation " << 100 * worst_layer << "% of rho0 g depth; mean "
                          << "density error " << 100 * worst_avg_error << "%");
         CHECK(worst_layer < 0.02);  // the static-wall column's bound (test_hydrostatic.cpp)

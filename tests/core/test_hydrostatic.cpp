@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <vector>
 
 #include "algorithms/sph_kernels.hpp"
@@ -23,16 +22,6 @@
 using namespace mw;
 
 namespace {
-// Fluid particle mass as the solver defines it (docs/solver.md): ρ0 / Σ_j W over the prototype
-// lattice at spacing r0 (h = 2 r0: offsets up to 2 along an axis), summed here on its own.
-double lattice_mass(const CubicSpline3D& kernel, double r0, double rest_density) {
-    double sum = 0;
-    for (int i = -2; i <= 2; ++i)
-        for (int j = -2; j <= 2; ++j)
-            for (int k = -2; k <= 2; ++k) sum += kernel.W(Real(r0 * std::sqrt(double(i * i + j * j + k * k))));
-    return rest_density / sum;
-}
-
 // Mean compression Σ max(ρ_i - ρ0, 0) / ρ0 / N over the fluid, with ρ_i recomputed from positions:
 // m Σ_j W(x_ij) over fluid j (i included) + ρ0 Σ_b V_b W(x_ib) over walls, V_b = 1 / Σ_b' W(x_bb').
 double recomputed_mean_compression(const std::vector<Vec3>& fluid, const std::vector<Vec3>& walls,
@@ -65,11 +54,10 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
     const int steps = 600, averaged = 50;
     const CubicSpline3D kernel = CubicSpline3D::with_support(2 * r0);
     const double rest_density = setup.params.fluid.rest_density;
-    const double mass = lattice_mass(kernel, r0, rest_density);
+    const double mass = test::lattice_mass(kernel, r0, rest_density);
     double worst_avg_error = 0, worst_recomputed = 0;
     int most_iterations = 0, diverged_steps = 0;
     std::vector<double> smoothed_sum;
-    std::vector<std::size_t> fluid_index;  // index in p of each entry of `fluid`
     std::vector<Vec3> fluid, walls;
     HostParticles p;
     for (int step = 0; step < steps; ++step) {
@@ -81,29 +69,13 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
         sim->download(p);
         fluid.clear();
         walls.clear();
-        fluid_index.clear();
         for (std::size_t i = 0; i < p.position.size(); ++i) {
-            if (p.type[i] == kFluid) {
-                fluid.push_back(p.position[i]);
-                fluid_index.push_back(i);
-            } else if (p.type[i] == kStaticBoundary) {
-                walls.push_back(p.position[i]);
-            }
+            if (p.type[i] == kFluid) fluid.push_back(p.position[i]);
+            if (p.type[i] == kStaticBoundary) walls.push_back(p.position[i]);
         }
         worst_recomputed =
             std::max(worst_recomputed, recomputed_mean_compression(fluid, walls, kernel, mass, rest_density));
-        smoothed_sum.resize(p.position.size(), 0.0);
-        const test::PointBins bins(fluid, kernel.h);
-        for (std::size_t k = 0; k < fluid.size(); ++k) {
-            double num = 0, den = 0;
-            bins.for_each_within(fluid[k], [&](std::uint32_t l, double r) {
-                const std::size_t j = fluid_index[l];
-                const double w = kernel.W(Real(r)) / p.density[j];
-                num += w * p.pressure[j];
-                den += w;
-            });
-            smoothed_sum[fluid_index[k]] += num / den;
-        }
+        test::add_smoothed_pressure(p, kernel, smoothed_sum);
     }
     // The stop rule was met on every step (a step that runs out of iterations ends with whatever
     // error it has), so the reported average error below means something.
@@ -123,22 +95,11 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
     const double H = top + r0 / 2, rho_g = 1000.0 * 9.81, margin = 2 * 2 * r0;
     CHECK(H == doctest::Approx(height).epsilon(0.03));  // the column neither collapsed nor rose
 
-    std::map<int, std::pair<double, int>> layers;  // layer -> (sum of relative deviation, count)
-    double worst_particle = 0;
-    for (std::size_t i = 0; i < p.position.size(); ++i) {
-        const Vec3 x = p.position[i];
-        if (p.type[i] != kFluid || x.x < margin || x.x > width - margin || x.z < margin || x.z > width - margin ||
-            x.y < margin || x.y > H - margin)
-            continue;
-        const double deviation = (smoothed_sum[i] / averaged - rho_g * (H - x.y)) / (rho_g * H);
-        worst_particle = std::max(worst_particle, std::fabs(deviation));
-        auto& layer = layers[int(x.y / r0)];
-        layer.first += deviation;
-        ++layer.second;
-    }
-    REQUIRE(layers.size() >= 10);
-    double worst_layer = 0;
-    for (const auto& [index, sum] : layers) worst_layer = std::max(worst_layer, std::fabs(sum.first / sum.second));
+    const test::HydrostaticProfile profile =
+        test::hydrostatic_profile(p, smoothed_sum, averaged, rho_g, 0, H, r0, Vec3{margin, margin, margin},
+                                  Vec3{width - margin, Real(H - margin), width - margin});
+    REQUIRE(profile.layers >= 10);
+    const double worst_layer = profile.worst_layer, worst_particle = profile.worst_particle;
     MESSAGE("settled H " << H << " m; worst layer deviation " << 100 * worst_layer
                          << "% of rho0 g H; worst smoothed particle " << 100 * worst_particle
                          << "%; mean density error " << 100 * worst_avg_error << "% (recomputed "

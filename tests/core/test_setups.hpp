@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <vector>
 
 #include "algorithms/simulation.hpp"
+#include "algorithms/sph_kernels.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/kdtree.hpp"
 
@@ -35,6 +37,17 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
     return setup;
 }
 
+// The fluid particle mass the solver uses, ρ0 / Σ W over the lattice offsets within h = 2 r0
+// (docs/solver.md), summed independently of the solver's own prototype_sums.
+template <class Kernel>
+double lattice_mass(const Kernel& kernel, double r0, double rest_density) {
+    double sum = 0;
+    for (int i = -2; i <= 2; ++i)
+        for (int j = -2; j <= 2; ++j)
+            for (int k = -2; k <= 2; ++k) sum += kernel.W(Real(r0 * std::sqrt(double(i * i + j * j + k * k))));
+    return rest_density / sum;
+}
+
 // Host-side neighbour search for the tests' own recomputations, independent of the solver's grid
 // (nanoflann, in double precision). for_each_within(x, f) calls f(k, r) for every point k (index
 // into the vector given) at distance r = |x - points[k]| < h.
@@ -59,5 +72,56 @@ class PointBins {
     std::unique_ptr<PointTree> tree_;  // refers to points_: built after it, destroyed before it
     mutable std::vector<std::pair<std::uint32_t, double>> found_;
 };
+
+// Adds each fluid particle's SPH-smoothed pressure, Σ_j W_ij p_j/ρ_j / Σ_j W_ij/ρ_j over fluid j,
+// to smoothed_sum[i] (indexed like p). PCISPH's raw per-particle pressure carries the step's
+// correction impulse (a scatter of about 10% of ρ0 g H); the smoothed field is what it gets right.
+inline void add_smoothed_pressure(const HostParticles& p, const CubicSpline3D& kernel,
+                                  std::vector<double>& smoothed_sum) {
+    std::vector<Vec3> fluid;
+    std::vector<std::size_t> index;  // index in p of each entry of `fluid`
+    for (std::size_t i = 0; i < p.position.size(); ++i)
+        if (p.type[i] == kFluid) fluid.push_back(p.position[i]), index.push_back(i);
+    smoothed_sum.resize(p.position.size(), 0.0);
+    const PointBins bins(fluid, kernel.h);
+    for (std::size_t k = 0; k < fluid.size(); ++k) {
+        double num = 0, den = 0;
+        bins.for_each_within(fluid[k], [&](std::uint32_t l, double r) {
+            const std::size_t j = index[l];
+            const double w = kernel.W(Real(r)) / p.density[j];
+            num += w * p.pressure[j];
+            den += w;
+        });
+        smoothed_sum[index[k]] += num / den;
+    }
+}
+
+// A settled column's pressure against p(y) = ρ0 g (top - y) over [bottom, top]: the smoothed
+// pressure averaged over `averaged` steps (smoothed_sum / averaged) for the fluid particles inside
+// `interior`, as a deviation relative to ρ0 g (top - bottom), averaged per layer r0 thick.
+struct HydrostaticProfile {
+    double worst_layer = 0, worst_particle = 0;
+    std::size_t layers = 0;
+};
+inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std::vector<double>& smoothed_sum,
+                                              int averaged, double rho_g, double bottom, double top, double r0,
+                                              Vec3 interior_lo, Vec3 interior_hi) {
+    std::map<int, std::pair<double, int>> layers;  // layer -> (sum of relative deviation, count)
+    HydrostaticProfile out;
+    for (std::size_t i = 0; i < p.position.size(); ++i) {
+        const Vec3 x = p.position[i];
+        if (p.type[i] != kFluid || x.x < interior_lo.x || x.x > interior_hi.x || x.y < interior_lo.y ||
+            x.y > interior_hi.y || x.z < interior_lo.z || x.z > interior_hi.z)
+            continue;
+        const double deviation = (smoothed_sum[i] / averaged - rho_g * (top - x.y)) / (rho_g * (top - bottom));
+        out.worst_particle = std::max(out.worst_particle, std::fabs(deviation));
+        auto& layer = layers[int((x.y - bottom) / r0)];
+        layer.first += deviation;
+        ++layer.second;
+    }
+    for (const auto& [index, sum] : layers) out.worst_layer = std::max(out.worst_layer, std::fabs(sum.first / sum.second));
+    out.layers = layers.size();
+    return out;
+}
 
 }  // namespace mw::test

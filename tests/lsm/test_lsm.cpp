@@ -4,6 +4,9 @@
 #include <doctest/doctest.h>
 
 #include <array>
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -32,66 +35,24 @@ double max_abs_diff(const Mat3& a, const Mat3& b) {
     return m;
 }
 
-// Host references in double precision, independent of the library's float algebra.
-using V3d = std::array<double, 3>;
-using M3d = std::array<V3d, 3>;  // rows
-V3d d3(Vec3 v) { return {double(v.x), double(v.y), double(v.z)}; }
-V3d operator+(V3d a, V3d b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-V3d operator-(V3d a, V3d b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V3d operator*(double s, V3d a) { return {s * a[0], s * a[1], s * a[2]}; }
-double dot3(V3d a, V3d b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double len3(V3d a) { return std::sqrt(dot3(a, a)); }
-V3d cross3(V3d a, V3d b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
-V3d operator*(const M3d& m, V3d v) { return {dot3(m[0], v), dot3(m[1], v), dot3(m[2], v)}; }
-M3d identity3() { return {V3d{1, 0, 0}, V3d{0, 1, 0}, V3d{0, 0, 1}}; }
-M3d transpose3(const M3d& a) {
-    M3d t;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) t[i][j] = a[j][i];
-    return t;
+// Host references in double precision (Eigen), independent of the library's float algebra.
+using V3d = Eigen::Vector3d;
+using M3d = Eigen::Matrix3d;
+V3d d3(Vec3 v) { return V3d(v.x, v.y, v.z); }
+// The rotation of the polar decomposition of A (the least-squares rotation), from its SVD.
+M3d polar3(const M3d& a) {
+    const Eigen::JacobiSVD<M3d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    M3d u = svd.matrixU();
+    if ((u * svd.matrixV().transpose()).determinant() < 0) u.col(2) *= -1;
+    return u * svd.matrixV().transpose();
 }
-M3d mul3(const M3d& a, const M3d& b) {
-    M3d c{};
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            for (int k = 0; k < 3; ++k) c[i][j] += a[i][k] * b[k][j];
-    return c;
-}
-// Inverse by cofactors (a must be invertible).
-M3d inverse3(const M3d& a) {
-    const V3d c0 = cross3(a[1], a[2]), c1 = cross3(a[2], a[0]), c2 = cross3(a[0], a[1]);
-    const double det = dot3(a[0], c0);
-    M3d inv;
-    for (int i = 0; i < 3; ++i) inv[i] = {c0[i] / det, c1[i] / det, c2[i] / det};
-    return inv;
-}
-// Rotation of the polar decomposition of an invertible A by Newton's iteration X <- (X + X^-T)/2,
-// which converges quadratically to the orthogonal factor.
-M3d polar3(M3d x) {
-    for (int it = 0; it < 60; ++it) {
-        const M3d y = transpose3(inverse3(x));
-        double change = 0;
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) {
-                const double v = 0.5 * (x[i][j] + y[i][j]);
-                change = std::max(change, std::fabs(v - x[i][j]));
-                x[i][j] = v;
-            }
-        if (change < 1e-15) break;
-    }
-    return x;
-}
-// Angle of the rotation a bᵀ (from its axial vector and trace: accurate for small angles too).
-double angle_between(const M3d& a, const M3d& b) {
-    const M3d r = mul3(a, transpose3(b));
-    const double s = 0.5 * len3(V3d{r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]});
-    return std::atan2(s, 0.5 * (r[0][0] + r[1][1] + r[2][2] - 1));
-}
+// Angle of the rotation a bᵀ.
+double angle_between(const M3d& a, const M3d& b) { return Eigen::AngleAxisd(a * b.transpose()).angle(); }
 
 // The best rigid motion x ≈ R (x0 - c0) + c of a set of equal-mass particles (least squares).
 struct RigidFit {
-    V3d c{}, c0{};
-    M3d R = identity3();
+    V3d c = V3d::Zero(), c0 = V3d::Zero();
+    M3d R = M3d::Identity();
     double residual = 0;  // largest |x - fit(x0)| over the particles
     V3d operator()(V3d x0) const { return R * (x0 - c0) + c; }
 };
@@ -100,23 +61,21 @@ RigidFit fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& x0, cons
     for (std::uint32_t i : ids) f.c = f.c + d3(x[i]), f.c0 = f.c0 + d3(x0[i]);
     f.c = (1.0 / double(ids.size())) * f.c;
     f.c0 = (1.0 / double(ids.size())) * f.c0;
-    M3d A{};
-    for (std::uint32_t i : ids) {
-        const V3d p = d3(x[i]) - f.c, q = d3(x0[i]) - f.c0;
-        for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b) A[a][b] += p[a] * q[b];
-    }
+    M3d A = M3d::Zero();
+    for (std::uint32_t i : ids) A += (d3(x[i]) - f.c) * (d3(x0[i]) - f.c0).transpose();
     f.R = polar3(A);
-    for (std::uint32_t i : ids) f.residual = std::max(f.residual, len3(d3(x[i]) - f(d3(x0[i]))));
+    for (std::uint32_t i : ids) f.residual = std::max(f.residual, (d3(x[i]) - f(d3(x0[i]))).norm());
     return f;
 }
 
 // A solid scene run directly on a particle store and SolidBodies (OpenMP, no neighbour sort, so
-// store order = scene order), for what the Simulation interface does not show (SBP normals).
+// store order = scene order), for what the Simulation interface does not show (goals, SBP
+// normals, chunked sums). `serial_limit` is SolidBodies::init's: the region size above which
+// sums are chunked.
 struct DirectSolids {
     openmp_backend::ParticleStore store;
     openmp_backend::SolidBodies bodies;
-    explicit DirectSolids(const SimulationSetup& s) {
+    explicit DirectSolids(const SimulationSetup& s, std::size_t serial_limit = kRegionSerialMembers) {
         openmp_backend::set_threads(1);  // as make_openmp: the suite runs beside other jobs on 2 cores
         const std::size_t n = s.position.size();
         store.resize(n, n);
@@ -126,7 +85,7 @@ struct DirectSolids {
         store.type.upload(s.type);
         store.position.upload(s.position);
         store.velocity.upload(s.velocity);
-        bodies.init(s, order, store);
+        bodies.init(s, order, store, serial_limit);
         bodies.update_slot_map(store);
     }
 };
@@ -189,16 +148,9 @@ TEST_CASE("goals reproduce a rigid translation plus rotation of the rest shape")
         SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, Real(0.01), Vec3{0, 0, 0});
         add(s, box_mesh(Vec3{0.2f, 0.1f, 0.04f}, Vec3{0.5f, 0.5f, 0.5f}), solid(kind, 1000, 2, 1));
         const std::size_t n = s.position.size();
-        openmp_backend::ParticleStore store;
-        store.resize(n, n);
-        std::vector<std::uint32_t> order(n);
-        for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
-        store.id.upload(order);
-        store.type.upload(s.type);
-        store.position.upload(s.position);
-        store.velocity.upload(s.velocity);
-        openmp_backend::SolidBodies bodies;
-        bodies.init(s, order, store);
+        DirectSolids direct(s);
+        openmp_backend::ParticleStore& store = direct.store;
+        openmp_backend::SolidBodies& bodies = direct.bodies;
         // Move every particle rigidly: x = Q (x0 - p) + p + T.
         const Mat3 Q = rotation_about(Vec3{1, 2, 3}, 1.1);
         const Vec3 p{0.5f, 0.5f, 0.5f}, T{0.1f, -0.05f, 0.2f};
@@ -259,7 +211,7 @@ TEST_CASE("spinning rigid body: GPs follow the rigid fit of the IBPs, SBPs their
         // by at most half an ulp, 2^-25 m; a few more for the rotation product.
         const double sum_rounding = double(most_links + 4) * std::ldexp(1.0, -25);
         DirectSolids run(s);
-        M3d previous = identity3();  // the start is the rest shape
+        M3d previous = M3d::Identity();  // the start is the rest shape
         std::vector<Vec3> gp_before(body.gp.size());
         for (std::size_t g = 0; g < body.gp.size(); ++g) gp_before[g] = s.position[body.gp[g]];
         double worst_gp = 0, worst_gp_velocity = 0, worst_sbp = 0, worst_sbp_velocity = 0, worst_normal_vs_triangle = 0;
@@ -285,7 +237,7 @@ TEST_CASE("spinning rigid body: GPs follow the rigid fit of the IBPs, SBPs their
             if (step == 0) {
                 first_residual = fit.residual;
                 double r_max = 0;
-                for (std::uint32_t i : ids) r_max = std::max(r_max, len3(d3(s.position[i]) - rest.c0));
+                for (std::uint32_t i : ids) r_max = std::max(r_max, (d3(s.position[i]) - rest.c0).norm());
                 // The sagitta r⊥ θ²/2 <= r_max θ²/2, with 2x room for the least-squares spread.
                 CHECK(first_residual < r_max * step_angle * step_angle);
             }
@@ -293,13 +245,13 @@ TEST_CASE("spinning rigid body: GPs follow the rigid fit of the IBPs, SBPs their
             std::vector<double> gp_error(body.gp.size());
             for (std::size_t g = 0; g < body.gp.size(); ++g) {
                 const std::uint32_t i = body.gp[g];
-                gp_error[g] = len3(d3(x[i]) - fit(d3(s.position[i])));
-                const double tolerance = step_angle * len3(offset[g]) + fit.residual + sum_rounding;
+                gp_error[g] = (d3(x[i]) - fit(d3(s.position[i]))).norm();
+                const double tolerance = step_angle * offset[g].norm() + fit.residual + sum_rounding;
                 worst_gp = std::max(worst_gp, gp_error[g] / tolerance);
                 largest_gp_tolerance = std::max(largest_gp_tolerance, tolerance);
                 // GP velocity is this step's displacement over Δt (float: a few ulps of |v|).
                 const V3d displacement_rate = (1.0 / double(dt)) * (d3(x[i]) - d3(gp_before[g]));
-                worst_gp_velocity = std::max(worst_gp_velocity, len3(d3(v[i]) - displacement_rate) / (1e-6 * len3(displacement_rate) + 1e-9));
+                worst_gp_velocity = std::max(worst_gp_velocity, (d3(v[i]) - displacement_rate).norm() / (1e-6 * displacement_rate.norm() + 1e-9));
                 gp_before[g] = x[i];
             }
             for (std::size_t k = 0; k < body.sbp.size(); ++k) {
@@ -313,28 +265,28 @@ TEST_CASE("spinning rigid body: GPs follow the rigid fit of the IBPs, SBPs their
                 // Three float products and two sums of values below 1 m (or 1 m/s), each rounding
                 // by at most half an ulp, 2^-25: at most 5 · 2^-25 = 1.5e-7.
                 const double combination_rounding = 5 * std::ldexp(1.0, -25);
-                worst_sbp = std::max(worst_sbp, len3(d3(x[body.sbp[k]]) - xb) / combination_rounding);
-                worst_sbp_velocity = std::max(worst_sbp_velocity, len3(d3(v[body.sbp[k]]) - vb) / combination_rounding);
+                worst_sbp = std::max(worst_sbp, (d3(x[body.sbp[k]]) - xb).norm() / combination_rounding);
+                worst_sbp_velocity = std::max(worst_sbp_velocity, (d3(v[body.sbp[k]]) - vb).norm() / combination_rounding);
                 // Normal: the deformed triangle's, oriented like the rest normal n0.
                 const V3d c0 = d3(x[body.gp[std::size_t(corner[0])]]), c1 = d3(x[body.gp[std::size_t(corner[1])]]),
                           c2 = d3(x[body.gp[std::size_t(corner[2])]]);
                 const V3d r0c0 = d3(s.position[body.gp[std::size_t(corner[0])]]), r0c1 = d3(s.position[body.gp[std::size_t(corner[1])]]),
                           r0c2 = d3(s.position[body.gp[std::size_t(corner[2])]]);
                 const V3d n0 = d3(body.sbp_normal[k]);
-                const V3d rest_cross = cross3(r0c1 - r0c0, r0c2 - r0c0);
-                const double sign = dot3(rest_cross, n0) < 0 ? -1.0 : 1.0;
-                const V3d tri = cross3(c1 - c0, c2 - c0);
-                const V3d tri_normal = (sign / len3(tri)) * tri;
+                const V3d rest_cross = (r0c1 - r0c0).cross(r0c2 - r0c0);
+                const double sign = rest_cross.dot(n0) < 0 ? -1.0 : 1.0;
+                const V3d tri = (c1 - c0).cross(c2 - c0);
+                const V3d tri_normal = (sign / tri.norm()) * tri;
                 const V3d n = d3(normal[k]);
                 // Against the host's normal of the same GPs: float cross product of edges of
                 // 0.02 m to 0.2 m, accurate to about 1e-6 rad.
-                worst_normal_vs_triangle = std::max(worst_normal_vs_triangle, len3(n - tri_normal) / 1e-5);
+                worst_normal_vs_triangle = std::max(worst_normal_vs_triangle, (n - tri_normal).norm() / 1e-5);
                 // Against R n0: corners off the rigid fit by e_j turn the normal of edges a = c1 - c0,
                 // b = c2 - c0 by at most (|a| (e2 + e0) + |b| (e1 + e0)) / |a × b| (first order).
                 const double e0 = gp_error[std::size_t(corner[0])], e1 = gp_error[std::size_t(corner[1])],
                              e2 = gp_error[std::size_t(corner[2])];
-                const double turn = (len3(r0c1 - r0c0) * (e2 + e0) + len3(r0c2 - r0c0) * (e1 + e0)) / len3(rest_cross);
-                const double normal_error = len3(n - fit.R * ((1.0 / len3(n0)) * n0));
+                const double turn = ((r0c1 - r0c0).norm() * (e2 + e0) + (r0c2 - r0c0).norm() * (e1 + e0)) / rest_cross.norm();
+                const double normal_error = (n - fit.R * ((1.0 / n0.norm()) * n0)).norm();
                 largest_normal_error = std::max(largest_normal_error, normal_error);
                 worst_normal = std::max(worst_normal, normal_error / (turn + 1e-5));
             }
@@ -343,9 +295,9 @@ TEST_CASE("spinning rigid body: GPs follow the rigid fit of the IBPs, SBPs their
         // How far off Eq. 19 without R would be at the end, per GP: |(R - I) o|.
         for (std::size_t g = 0; g < body.gp.size(); ++g) {
             const V3d o = offset[g];
-            ignored_rotation_error = std::max(ignored_rotation_error, len3(fit.R * o - o));
+            ignored_rotation_error = std::max(ignored_rotation_error, (fit.R * o - o).norm());
         }
-        const double turned = angle_between(fit.R, identity3());
+        const double turned = angle_between(fit.R, M3d::Identity());
         MESSAGE(std::string(shape.name) << ": " << ids.size() << " IBPs, " << body.gp.size() << " GPs, " << body.sbp.size()
                 << " SBPs; turned " << turned << " rad (largest step " << largest_step_angle << "); worst/tolerance: GP "
                 << worst_gp << ", GP velocity " << worst_gp_velocity << ", SBP " << worst_sbp << ", SBP velocity "
@@ -384,22 +336,16 @@ TEST_CASE("regions summed in chunks agree with one-thread sums (rigid and elasti
             velocity[i] = Vec3{0.3f, 0, -0.1f} + cross(Vec3{0, 2, 1}, s.position[i] - p) + Real(0.1) * jitter;
         }
         const std::size_t n = s.position.size();
-        std::vector<std::uint32_t> order(n);
-        for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
         // The same body twice: regions summed by one thread each, and in chunks (the elastic
         // regions, 125 members, are chunked only when the limit is lowered below that).
         const std::size_t chunked_limit = kind == SolidKind::kRigid ? kRegionSerialMembers : 64;
         std::vector<Vec3> goals[2], velocities[2];
         std::size_t chunks[2] = {0, 0};
         for (int variant = 0; variant < 2; ++variant) {
-            openmp_backend::ParticleStore store;
-            store.resize(n, n);
-            store.id.upload(order);
-            store.type.upload(s.type);
-            store.position.upload(s.position);
+            DirectSolids direct(s, variant == 0 ? std::size_t(-1) : chunked_limit);
+            openmp_backend::ParticleStore& store = direct.store;
+            openmp_backend::SolidBodies& bodies = direct.bodies;
             store.velocity.upload(velocity);
-            openmp_backend::SolidBodies bodies;
-            bodies.init(s, order, store, variant == 0 ? std::size_t(-1) : chunked_limit);
             chunks[variant] = bodies.region_chunk_count();
             store.position.upload(moved);
             goals[variant] = bodies.goals(store);
@@ -492,7 +438,7 @@ TEST_CASE("free fall: the IBPs' centre of mass follows symplectic Euler exactly 
             mean = (1.0 / double(ids.size())) * mean;
             REQUIRE(low_now > floor_y);  // no wall contact yet
             const V3d expected{start[0] + n * double(dt) * double(v0.x), start[1] + drop(n), start[2] + n * double(dt) * double(v0.z)};
-            const double error = len3(mean - expected);
+            const double error = (mean - expected).norm();
             // Each step's x += Δt v rounds every coordinate (below 1 m) by at most half an ulp,
             // 2^-25 m, so the mean can be off by n · 2^-25 per axis, √3 n · 2^-25 in all. The
             // velocity's rounding (v < 4 m/s: 2^-23 m/s per step) adds Δt n² 2^-24 < 2e-9 m here.
@@ -539,8 +485,8 @@ TEST_CASE("wall contact: IBPs clamped to the margin r0/2, outward velocity dropp
                              double(v0.z) * std::pow(keep, walls)};
         const V3d free_x = d3(s.position[i]) + double(dt) * d3(v0);
         const V3d expected_x{at_x ? double(margin) : free_x[0], at_y ? double(margin) : free_x[1], free_x[2]};
-        worst_velocity = std::max(worst_velocity, len3(d3(h.velocity[i]) - expected_v));
-        worst_position = std::max(worst_position, len3(d3(h.position[i]) - expected_x));
+        worst_velocity = std::max(worst_velocity, (d3(h.velocity[i]) - expected_v).norm());
+        worst_position = std::max(worst_position, (d3(h.position[i]) - expected_x).norm());
     }
     MESSAGE("IBPs free " << touching[0] << ", on the x wall " << touching[1] << ", on the floor " << touching[2] << ", on both "
                          << touching[3] << "; largest velocity error " << worst_velocity << " m/s, position error " << worst_position << " m");
@@ -638,19 +584,19 @@ TEST_CASE("damping keeps linear and angular momentum and removes deformation ene
         double kinetic = 0;
         for (std::uint32_t i : ids) {
             c = c + d3(h.position[i]), p = p + mass * d3(h.velocity[i]);
-            kinetic += 0.5 * mass * dot3(d3(h.velocity[i]), d3(h.velocity[i]));
+            kinetic += 0.5 * mass * d3(h.velocity[i]).dot(d3(h.velocity[i]));
         }
         const double M = mass * double(ids.size());
         c = (1.0 / double(ids.size())) * c;
         V3d L{0, 0, 0};
-        M3d I{};
+        M3d I = M3d::Zero();
         for (std::uint32_t i : ids) {
             const V3d r = d3(h.position[i]) - c;
-            L = L + mass * cross3(r, d3(h.velocity[i]) - (1.0 / M) * p);
+            L = L + mass * r.cross(d3(h.velocity[i]) - (1.0 / M) * p);
             for (int a = 0; a < 3; ++a)
-                for (int b = 0; b < 3; ++b) I[a][b] += mass * ((a == b ? dot3(r, r) : 0.0) - r[a] * r[b]);
+                for (int b = 0; b < 3; ++b) I(a, b) += mass * ((a == b ? r.dot(r) : 0.0) - r[a] * r[b]);
         }
-        return kinetic - 0.5 * dot3(p, p) / M - 0.5 * dot3(L, inverse3(I) * L);
+        return kinetic - 0.5 * p.dot(p) / M - 0.5 * L.dot(I.inverse() * L);
     };
     HostParticles h;
     auto sim = make_openmp(s);
