@@ -9,6 +9,34 @@
 
 namespace mw {
 
+namespace {
+// cxxopts names the offending token between its quotes (typographic or ASCII, by platform); the
+// token alone lets the message be worded in this program's style.
+std::string quoted_token(const std::string& message) {
+    for (const char* open : {"\u2018", "'"}) {
+        const char* close = open[0] == '\'' ? "'" : "\u2019";
+        const std::size_t begin = message.find(open);
+        if (begin == std::string::npos) continue;
+        const std::size_t first = begin + std::string(open).size();
+        const std::size_t end = message.find(close, first);
+        if (end != std::string::npos) return message.substr(first, end - first);
+    }
+    return message;
+}
+
+// Which option on the command line was given `value` ("--steps abc", "--steps=abc" or "-s abc"),
+// so that a value that fails to parse is reported with its option's name.
+std::string option_given_value(const std::vector<char*>& args, const std::string& value) {
+    for (std::size_t i = 1; i < args.size(); ++i) {
+        const std::string a = args[i];
+        const std::size_t eq = a.find('=');
+        if (a.rfind("--", 0) == 0 && eq != std::string::npos && a.substr(eq + 1) == value) return a.substr(0, eq);
+        if (a == value && a.rfind("-", 0) != 0 && std::string(args[i - 1]).rfind("-", 0) == 0) return args[i - 1];
+    }
+    return "an option";
+}
+}  // namespace
+
 void add_scene_options(cxxopts::Options& options) {
     options.add_options()
         ("scene", "scene file (JSON); the built-in 3D dam break when omitted", cxxopts::value<std::string>())
@@ -48,9 +76,24 @@ cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** a
                     throw InputError("--" + given[a].key() + " is given more than once ('" + given[b].value() +
                                      "', then '" + given[a].value() + "'); give it once");
         return result;
+    } catch (const cxxopts::exceptions::incorrect_argument_type& e) {
+        const std::string value = quoted_token(e.what());
+        throw InputError(option_given_value(rest, value) + ": '" + value + "' is not a valid value" +
+                         " (see '" + options.program() + " --help')");
+    } catch (const cxxopts::exceptions::missing_argument& e) {
+        throw InputError("--" + quoted_token(e.what()) + " needs a value");
+    } catch (const cxxopts::exceptions::no_such_option& e) {
+        const std::string name = quoted_token(e.what());
+        throw InputError("unknown option '" + std::string(name.size() == 1 ? "-" : "--") + name + "'");
     } catch (const cxxopts::exceptions::exception& e) {
         throw InputError(e.what());
     }
+}
+
+bool flag_option(const cxxopts::ParseResult& args, const std::string& name) {
+    // A flag is a bool with an implicit "true": `--quiet=false` parses to false, and count() alone
+    // would take it as set.
+    return args.count(name) > 0 && args[name].as<bool>();
 }
 
 Scene scene_from_options(const cxxopts::ParseResult& result, const std::vector<std::string>& overrides) {

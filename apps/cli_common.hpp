@@ -21,6 +21,9 @@ void add_scene_options(cxxopts::Options& options);
 cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** argv,
                                    std::vector<std::string>* overrides = nullptr);
 
+// Whether the flag `name` is set: `--quiet` and `--quiet=true` set it, `--quiet=false` does not.
+bool flag_option(const cxxopts::ParseResult& args, const std::string& name);
+
 // The scene named on the command line (or the built-in default) with the --set overrides applied.
 Scene scene_from_options(const cxxopts::ParseResult& result, const std::vector<std::string>& overrides);
 

@@ -11,13 +11,13 @@ int command_backends(int argc, char** argv) {
     cxxopts::Options options("meltwater backends", "The backends compiled into this program and the devices found.");
     options.add_options()("json", "print one JSON object instead of text")("h,help", "show this help");
     const cxxopts::ParseResult args = parse_options(options, argc, argv);
-    if (args.count("help")) {
+    if (flag_option(args, "help")) {
         std::printf("%s\n", options.help().c_str());
         return 0;
     }
     const BackendInfo infos[] = {cuda_backend_info(), openmp_backend_info()};
     const std::string chosen = choose_backend("auto");
-    if (args.count("json")) {
+    if (flag_option(args, "json")) {
         SceneJson j;
         for (const BackendInfo& b : infos)
             j["backends"].push_back({{"name", b.name}, {"compiled", b.compiled}, {"available", b.available},

@@ -21,7 +21,7 @@ int command_info(int argc, char** argv) {
         cxxopts::value<std::string>()->default_value("auto"));
     std::vector<std::string> overrides;
     const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
-    if (args.count("help")) {
+    if (flag_option(args, "help")) {
         std::printf("%s\n", options.help().c_str());
         return 0;
     }
@@ -44,7 +44,7 @@ int command_info(int argc, char** argv) {
     const bool cfl = solver.dt_mode == TimeStepMode::kCfl;
     const long frames = scene.writes_vtu() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
 
-    if (args.count("json")) {
+    if (flag_option(args, "json")) {
         SceneJson j;
         j["scene_name"] = scene.name;
         j["scene_source"] = scene.source;

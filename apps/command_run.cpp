@@ -67,7 +67,7 @@ int command_run(int argc, char** argv) {
         ("q,quiet", "print only the final summary line and errors");
     std::vector<std::string> overrides;
     const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
-    if (args.count("help")) {
+    if (flag_option(args, "help")) {
         std::printf("%s\n", options.help().c_str());
         return 0;
     }
@@ -78,7 +78,7 @@ int command_run(int argc, char** argv) {
         if (end_steps < 1) throw InputError("--steps must be at least 1, got " + std::to_string(end_steps));
     }
     const int threads = threads_option(args);
-    const bool quiet = args.count("quiet") > 0;
+    const bool quiet = flag_option(args, "quiet");
     const StopSignals stop_signals;
 
     Scene scene = scene_from_options(args, overrides);

@@ -110,7 +110,7 @@ int command_sample(int argc, char** argv) {
     options.parse_positional({"mesh"});
     options.positional_help("MESH");
     const cxxopts::ParseResult args = parse_options(options, argc, argv);
-    if (args.count("help")) {
+    if (flag_option(args, "help")) {
         std::printf("%s\n", options.help().c_str());
         return 0;
     }
@@ -152,7 +152,7 @@ int command_sample(int argc, char** argv) {
     OutputDirectory output(out_dir);
     SampleOptions opt;
     opt.inside.directions = directions;
-    opt.measure_coverage = !args.count("no-coverage");
+    opt.measure_coverage = !flag_option(args, "no-coverage");
     const SolidSample s = sample_solid(mesh, r0, h, opt);
     const SampleStats& st = s.stats;
     if (s.ibp.count() == 0) {

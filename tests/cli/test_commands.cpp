@@ -83,7 +83,12 @@ TEST_CASE("bad input: command line") {
     check_rejected(run("run " + tiny() + " --frobnicate"), {"frobnicate"});
     check_rejected(run("run " + tiny() + " --steps 2 --time 0.1"), {"--steps", "--time"});
     check_rejected(run("run " + tiny() + " --steps 0"), {"--steps"});
-    check_rejected(run("run " + tiny() + " --steps many"), {"many"});
+    // A value that does not parse is reported with the option it was given to, in every spelling.
+    check_rejected(run("run " + tiny() + " --steps many"), {"--steps", "'many'"});
+    check_rejected(run("run " + tiny() + " --threads=2.5"), {"--threads", "'2.5'"});
+    check_rejected(run("run " + tiny() + " --quiet=maybe"), {"--quiet", "'maybe'"});
+    check_rejected(run("run " + tiny() + " --steps"), {"--steps", "needs a value"});
+    check_rejected(run("sample x --spacing abc"), {"--spacing", "'abc'"});
     check_rejected(run("run " + tiny() + " --time -1"), {"--time"});
     check_rejected(run("run " + tiny() + " --threads 0"), {"--threads"});
     check_rejected(run("run " + tiny() + " --backend vulkan"), {"--backend", "vulkan"});
@@ -402,6 +407,10 @@ TEST_CASE("run: plain progress lines when stderr is not a terminal") {
     CHECK(contains(r.err, "100%"));
     CHECK(contains(r.err, "ms/step"));
     CHECK(!contains(r.err, "\r"));
+    // A flag set to false is off, as it reads: --quiet=false keeps the progress lines.
+    const Result loud = run("run " + tiny() + " --steps 2 --quiet=false --out " + out_dir("loud") + " --set 'output.formats=[]'");
+    REQUIRE(loud.code == 0);
+    CHECK(contains(loud.err, "ms/step"));
 }
 
 TEST_CASE("a frame reads back with meshio") {
