@@ -7,6 +7,7 @@
 
 #include "backend/errors.hpp"
 #include "sampling/box_particles.hpp"
+#include "sampling/inside_outside.hpp"
 #include "sampling/kdtree.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
@@ -67,6 +68,54 @@ void check_object_particle_budget(const Scene& scene, const TriangleMesh& mesh, 
                          "); increase fluid.spacing or scale the object down");
 }
 
+// An object as placed in the scene, for the overlap check: its mesh and its inner particles.
+struct PlacedObject {
+    TriangleMesh mesh;
+    Eigen::AlignedBox3d bounds;
+    std::vector<Vec3d> inner;  // IBP positions (inner lattice points for a static object)
+    bool moves = false;        // elastic or rigid; static objects never move
+};
+
+// Solids collide only with the domain walls: two objects, or an object and a static box, that
+// start inside one another stay so, and their boundary particles count twice in the fluid's
+// density. Refused when a moving object is involved; static solids may overlap one another (a
+// static mesh sunk into a static floor box is a way to build scenery). An overlap shallower than
+// the inner particles' depth (about r0/2) is not seen; touching is fine.
+void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& placed) {
+    const auto describe = [&](std::size_t k) {
+        return "objects[" + std::to_string(k) + "] (" + scene.objects[k].name + ")";
+    };
+    for (std::size_t k = 0; k < placed.size(); ++k) {
+        const PlacedObject& a = placed[k];
+        for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
+            if (!a.moves) continue;
+            const StaticBox& b = scene.static_boxes[i];
+            const Eigen::AlignedBox3d box(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
+            const long inside = std::count_if(a.inner.begin(), a.inner.end(), [&](const Vec3d& x) { return box.contains(x); });
+            if (inside > 0)
+                throw InputError(scene.source + ": " + describe(k) + " overlaps static_boxes[" + std::to_string(i) +
+                                 "]: " + std::to_string(inside) + " of its " + std::to_string(a.inner.size()) +
+                                 " inner particles lie inside the box; objects do not collide with static boxes, so "
+                                 "move it out (touching is fine)");
+        }
+        for (std::size_t j = 0; j < placed.size(); ++j) {
+            const PlacedObject& b = placed[j];
+            if (j == k || (!a.moves && !b.moves) || !a.bounds.intersects(b.bounds)) continue;
+            std::vector<Vec3d> candidates;
+            for (const Vec3d& x : a.inner)
+                if (b.bounds.contains(x)) candidates.push_back(x);
+            if (candidates.empty()) continue;
+            const std::vector<std::uint8_t> inside = classify_points(b.mesh, candidates);
+            const long count = std::count(inside.begin(), inside.end(), std::uint8_t(1));
+            if (count > 0)
+                throw InputError(scene.source + ": " + describe(k) + " overlaps " + describe(j) + ": " +
+                                 std::to_string(count) + " of its " + std::to_string(a.inner.size()) +
+                                 " inner particles lie inside the other's mesh; objects do not collide with one "
+                                 "another, so move them apart (touching is fine)");
+        }
+    }
+}
+
 }  // namespace
 
 ParticleEstimate estimate_particles(const Scene& scene) {
@@ -118,6 +167,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                static_cast<std::int32_t>(i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }
+    std::vector<PlacedObject> placed;
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
         const SceneObject& o = scene.objects[k];
         SolidSetup solid;
@@ -140,11 +190,21 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         }
         const std::int32_t id = static_cast<std::int32_t>(scene.static_boxes.size() + k);
         try {
-            const TriangleMesh mesh = object_mesh(scene, o);
-            check_object_inside_domain(scene, mesh);
-            check_object_particle_budget(scene, mesh, setup.position.size());
-            add_solid_object(setup, mesh, solid, o.velocity, id, scene.params.fluid.spacing,
-                             scene.params.fluid.support_radius, pinned);
+            PlacedObject object;
+            object.mesh = object_mesh(scene, o);
+            object.moves = o.kind != SolidKind::kStatic;
+            check_object_inside_domain(scene, object.mesh);
+            check_object_particle_budget(scene, object.mesh, setup.position.size());
+            const std::size_t first = setup.position.size();
+            const std::size_t inner = add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
+                                                       scene.params.fluid.support_radius, pinned);
+            for (std::size_t i = first; i < first + inner; ++i) {
+                const Vec3 x = setup.position[i];
+                object.inner.emplace_back(x.x, x.y, x.z);
+            }
+            const Aabb box = bounding_box(object.mesh);
+            object.bounds = Eigen::AlignedBox3d(box.lo, box.hi);
+            placed.push_back(std::move(object));
         } catch (const InputError& e) {
             throw InputError(scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + "): " + e.what());
         }
@@ -152,6 +212,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             throw InputError(scene.source + ": the objects create more than " + std::to_string(kMaxSceneParticles) +
                              " particles; increase fluid.spacing");
     }
+    check_objects_apart(scene, placed);
     long carved = 0;
     if (setup.position.size() > first_solid) {
         const std::vector<std::uint8_t> removed = carve_fluid(setup, Real(kFluidClearance) * r0, boxes, first_solid);
@@ -236,8 +297,9 @@ TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {
     return mesh;
 }
 
-void add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
-                      std::int32_t object_id, double r0, double h, const std::function<bool(const Vec3&)>& pinned) {
+std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
+                             std::int32_t object_id, double r0, double h,
+                             const std::function<bool(const Vec3&)>& pinned) {
     SampleOptions options;
     options.measure_coverage = false;
     const SolidSample sample = sample_solid(mesh, r0, h, options);
@@ -262,7 +324,7 @@ void add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSet
         for (const auto& p : sample.sbp.positions) push(to_vec3(p), kStaticBoundary);
         for (const auto& v : mesh.vertices) solid.rest_vertices.push_back(to_vec3(v));
         setup.solids.push_back(std::move(solid));
-        return;
+        return sample.ibp.count();
     }
     for (std::size_t k = 0; k < sample.ibp.count(); ++k) {
         const Vec3 x = to_vec3(sample.ibp.positions[k]);
@@ -282,6 +344,7 @@ void add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSet
         solid.sbp_normal.push_back(to_vec3(sample.sbp.normals[k]));
     }
     setup.solids.push_back(std::move(solid));
+    return sample.ibp.count();
 }
 
 ParticleCounts count_particles(const SimulationSetup& setup) {

@@ -44,8 +44,9 @@ std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
 // Samples `mesh` (already in world coordinates) at spacing r0 and support h and appends the object
 // to `setup`: its IBPs, SBPs and GPs as particles (static objects: IBPs and SBPs as static boundary
 // particles) with `velocity`, and a SolidSetup built from `solid` (kind, density, LSM settings,
-// name) with the particle links filled in. IBPs for which `pinned` is true stay at rest.
-void add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
+// name) with the particle links filled in. IBPs for which `pinned` is true stay at rest. Returns
+// the number of inner particles, which are appended first.
+std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
                       std::int32_t object_id, double r0, double h,
                       const std::function<bool(const Vec3&)>& pinned = nullptr);
 

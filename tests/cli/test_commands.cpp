@@ -240,6 +240,27 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(jc["device_bytes"].get<long>() < jo["device_bytes"].get<long>());
 }
 
+TEST_CASE("bad input: a moving object that starts inside another object or a static box") {
+    // 0.04 m cubes at r0 = 0.02 m: 2 x 2 x 2 inner particles, 0.01 m inside each face.
+    const auto cube = [](const std::string& kind, double x) {
+        return R"({"kind": ")" + kind + R"(", "mesh": {"procedural": "box:x=0.04,y=0.04,z=0.04"},
+                   "transform": {"translation": [)" + std::to_string(x) + ", 0.16, 0.16]}}";
+    };
+    const auto scene = [&](const std::string& name, const std::string& objects, const std::string& boxes = "") {
+        return scene_file(name + ".json", tiny_scene_text((boxes.empty() ? "" : R"("static_boxes": [)" + boxes + "],\n") +
+                                                          R"("objects": [)" + objects + "]"));
+    };
+    // Half a cube deep: the four inner particles of one face lie inside the other cube.
+    check_rejected(run("info " + scene("overlap", cube("elastic", 0.08) + "," + cube("rigid", 0.1))),
+                   {"objects[0]", "overlaps objects[1]", "4 of its 8 inner particles"});
+    check_rejected(run("info " + scene("in_box", cube("elastic", 0.08), R"({"min": [0.075, 0.12, 0.12], "max": [0.2, 0.2, 0.2]})")),
+                   {"objects[0]", "overlaps static_boxes[0]", "4 of its 8"});
+    // Touching is fine, and so are static solids sunk into one another (scenery).
+    CHECK(run("info " + scene("touching", cube("elastic", 0.08) + "," + cube("elastic", 0.12))).code == 0);
+    CHECK(run("info " + scene("static_pair", cube("static", 0.08) + "," + cube("static", 0.1),
+                              R"({"min": [0.07, 0.12, 0.12], "max": [0.2, 0.2, 0.2]})")).code == 0);
+}
+
 TEST_CASE("a static box and an object inside the fluid carve it out, and the run starts at rest") {
     // The tiny scene's block (125 particles, 0.1 m cube in a corner of the tank) with a static box
     // standing in one corner of it and an elastic cube in another.
