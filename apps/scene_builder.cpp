@@ -81,16 +81,15 @@ struct PlacedObject {
 // density. Refused when a moving object is involved; static solids may overlap one another (a
 // static mesh sunk into a static floor box is a way to build scenery). An overlap shallower than
 // the inner particles' depth (about r0/2) is not seen; touching is fine.
-void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& placed) {
+void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& placed,
+                         const std::vector<Eigen::AlignedBox3d>& static_boxes) {
     const auto describe = [&](std::size_t k) {
         return "objects[" + std::to_string(k) + "] (" + scene.objects[k].name + ")";
     };
     for (std::size_t k = 0; k < placed.size(); ++k) {
         const PlacedObject& a = placed[k];
-        for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
-            if (!a.moves) continue;
-            const StaticBox& b = scene.static_boxes[i];
-            const Eigen::AlignedBox3d box(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
+        for (std::size_t i = 0; a.moves && i < static_boxes.size(); ++i) {
+            const Eigen::AlignedBox3d& box = static_boxes[i];
             const long inside = std::count_if(a.inner.begin(), a.inner.end(), [&](const Vec3d& x) { return box.contains(x); });
             if (inside > 0)
                 throw InputError(scene.source + ": " + describe(k) + " overlaps static_boxes[" + std::to_string(i) +
@@ -167,6 +166,8 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                static_cast<std::int32_t>(i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }
+    // Every object's mesh and inner particles, kept where there is something for it to overlap.
+    const bool check_overlaps = scene.objects.size() > 1 || (!scene.objects.empty() && !scene.static_boxes.empty());
     std::vector<PlacedObject> placed;
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
         const SceneObject& o = scene.objects[k];
@@ -198,13 +199,13 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             const std::size_t first = setup.position.size();
             const std::size_t inner = add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
                                                        scene.params.fluid.support_radius, pinned);
-            for (std::size_t i = first; i < first + inner; ++i) {
+            for (std::size_t i = first; check_overlaps && i < first + inner; ++i) {
                 const Vec3 x = setup.position[i];
                 object.inner.emplace_back(x.x, x.y, x.z);
             }
             const Aabb box = bounding_box(object.mesh);
             object.bounds = Eigen::AlignedBox3d(box.lo, box.hi);
-            placed.push_back(std::move(object));
+            if (check_overlaps) placed.push_back(std::move(object));
         } catch (const InputError& e) {
             throw InputError(scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + "): " + e.what());
         }
@@ -212,7 +213,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             throw InputError(scene.source + ": the objects create more than " + std::to_string(kMaxSceneParticles) +
                              " particles; increase fluid.spacing");
     }
-    check_objects_apart(scene, placed);
+    check_objects_apart(scene, placed, boxes);
     long carved = 0;
     if (setup.position.size() > first_solid) {
         const std::vector<std::uint8_t> removed = carve_fluid(setup, Real(kFluidClearance) * r0, boxes, first_solid);
