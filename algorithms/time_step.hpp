@@ -70,7 +70,7 @@ class BackendSimulation final : public Simulation {
         DensityError error;
         if (has_fluid_) {
             timers_.start(kPcisph);
-            const Real floor = std::min(params_.solver.dt_min, params_.solver.dt);
+            const Real smallest_dt = std::min(params_.solver.dt_min, params_.solver.dt);
             for (;;) {
                 const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
                 int tried = 0;
@@ -79,7 +79,7 @@ class BackendSimulation final : public Simulation {
                             : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, tried, diverged);
                 iterations += tried;
                 if (!diverged || params_.solver.dt_mode != TimeStepMode::kCfl || retries == kMaxRetries ||
-                    Real(0.5) * dt < floor)
+                    Real(0.5) * dt < smallest_dt)
                     break;
                 dt *= Real(0.5);
                 ++retries;

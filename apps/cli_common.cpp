@@ -202,6 +202,8 @@ std::string with_thousands(long n) {
     return n < 0 ? "-" + out : out;
 }
 
+std::string count_of(long n, const std::string& noun) { return with_thousands(n) + " " + noun + (n == 1 ? "" : "s"); }
+
 std::string format_bytes(double bytes) {
     const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
     int u = 0;

@@ -51,6 +51,7 @@ void check_host_memory(const Scene& scene, const std::string& backend, bool host
 int threads_option(const cxxopts::ParseResult& args);
 
 std::string with_thousands(long n);
+std::string count_of(long n, const std::string& noun);  // "1 step", "1,209 steps"
 std::string format_number(double v);  // %g: 1e+300, 0.02
 std::string format_bytes(double bytes);
 std::string format_duration(double seconds);  // h:mm:ss or m:ss

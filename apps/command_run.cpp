@@ -249,16 +249,15 @@ int command_run(int argc, char** argv) {
         std::fprintf(stderr,
                      "meltwater: note: %s taken again at a smaller dt because PCISPH diverged (column "
                      "dt_retries of stats.csv; docs/solver.md, \"Flat impacts\")\n",
-                     (with_thousands(stats.retried_steps()) + (stats.retried_steps() == 1 ? " step was" : " steps were"))
-                         .c_str());
+                     (count_of(stats.retried_steps(), "step") + (stats.retried_steps() == 1 ? " was" : " were")).c_str());
     if (stats.diverged_steps() > 0)
         std::fprintf(stderr,
                      "meltwater: warning: in %s PCISPH diverged and the step was integrated anyway (column "
                      "diverged of stats.csv); use a smaller dt, or dt_mode \"cfl\" with solver.eta_max\n",
-                     (with_thousands(stats.diverged_steps()) + (stats.diverged_steps() == 1 ? " step" : " steps")).c_str());
+                     count_of(stats.diverged_steps(), "step").c_str());
     if (summary.lost_particles > 0)
-        std::fprintf(stderr, "meltwater: warning: %s fluid particles left the domain (column lost_particles of stats.csv)\n",
-                     with_thousands(summary.lost_particles).c_str());
+        std::fprintf(stderr, "meltwater: warning: %s left the domain (column lost_particles of stats.csv)\n",
+                     count_of(summary.lost_particles, "fluid particle").c_str());
     std::error_code ec;
     const std::string shown = std::filesystem::absolute(out_dir, ec).lexically_normal().string();
     // The fluid's figures mean nothing in a scene without fluid (all zero): say so instead.
@@ -269,8 +268,8 @@ int command_run(int argc, char** argv) {
     std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",
                 interrupted ? "interrupted after" : "ran", summary.steps, summary.simulated_time, summary.wall_seconds,
                 stats.median_total_ms(), fluid_figures);
-    std::printf("meltwater: results in %s (%d frame%s in frames/, stats.csv, summary.json)\n",
-                ec ? out_dir.c_str() : shown.c_str(), summary.frames, summary.frames == 1 ? "" : "s");
+    std::printf("meltwater: results in %s (%s in frames/, stats.csv, summary.json)\n",
+                ec ? out_dir.c_str() : shown.c_str(), count_of(summary.frames, "frame").c_str());
     std::fflush(stdout);
     return interrupted ? 130 : 0;
 }

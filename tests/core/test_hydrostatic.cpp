@@ -27,12 +27,7 @@ namespace {
 double recomputed_mean_compression(const std::vector<Vec3>& fluid, const std::vector<Vec3>& walls,
                                    const CubicSpline3D& kernel, double mass, double rest_density) {
     const test::PointBins fluid_bins(fluid, kernel.h), wall_bins(walls, kernel.h);
-    std::vector<double> wall_volume(walls.size());
-    for (std::size_t b = 0; b < walls.size(); ++b) {
-        double sum = 0;
-        wall_bins.for_each_within(walls[b], [&](std::uint32_t, double r) { sum += kernel.W(Real(r)); });
-        wall_volume[b] = 1 / sum;
-    }
+    const std::vector<double> wall_volume = test::akinci_volumes(walls, wall_bins, kernel);
     double compression = 0;
     for (const Vec3& x : fluid) {
         double fluid_sum = 0, wall_sum = 0;

@@ -73,6 +73,19 @@ class PointBins {
     mutable std::vector<std::pair<std::uint32_t, double>> found_;
 };
 
+// Akinci boundary volumes V_b = 1 / Σ_b' W(x_bb') over the points of `bins` (b itself included),
+// recomputed on the host, independently of the solver's compute_boundary_volumes.
+inline std::vector<double> akinci_volumes(const std::vector<Vec3>& boundary, const PointBins& bins,
+                                          const CubicSpline3D& kernel) {
+    std::vector<double> volume(boundary.size());
+    for (std::size_t b = 0; b < boundary.size(); ++b) {
+        double sum = 0;
+        bins.for_each_within(boundary[b], [&](std::uint32_t, double r) { sum += kernel.W(Real(r)); });
+        volume[b] = 1 / sum;
+    }
+    return volume;
+}
+
 // Adds each fluid particle's SPH-smoothed pressure, Σ_j W_ij p_j/ρ_j / Σ_j W_ij/ρ_j over fluid j,
 // to smoothed_sum[i] (indexed like p). PCISPH's raw per-particle pressure carries the step's
 // correction impulse (a scatter of about 10% of ρ0 g H); the smoothed field is what it gets right.
