@@ -48,6 +48,19 @@ int report_interrupted_setup() {
     return 130;
 }
 
+// The lost-fluid guard's message: the step, how much fluid left, the limit, and the likely cause.
+std::string lost_fluid_message(const StepReport& r, long fluid_count, long diverged_steps, const Scene& scene) {
+    char head[200];
+    std::snprintf(head, sizeof head, "step %ld (t = %.6g s): %s of %s (%.3g%%) have left the domain, more than ",
+                  r.step, r.time, with_thousands(r.lost_particles).c_str(),
+                  count_of(fluid_count, "fluid particle").c_str(), 100.0 * double(r.lost_particles) / double(fluid_count));
+    return head + ("boundary.max_lost_fraction " + format_number(scene.max_lost_fraction)) +
+           (diverged_steps > 0 ? "; PCISPH diverged in " + count_of(diverged_steps, "step") +
+                                     " so far (column diverged of stats.csv): use a smaller dt, or dt_mode \"cfl\""
+                               : std::string("; the fluid leaked through the walls or blew up (see the last frames "
+                                             "and stats.csv)"));
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -197,6 +210,10 @@ int command_run(int argc, char** argv) {
             summary.simulated_time = r.time;
             summary.lost_particles = r.lost_particles;
             progress.update(r);
+            if (r.lost_particles > scene.max_lost_fraction * double(summary.particles.by_type[kFluid])) {
+                progress.finish();
+                throw SimulationError(lost_fluid_message(r, summary.particles.by_type[kFluid], stats.diverged_steps(), scene));
+            }
             if (r.time >= next_frame_time * (1 - 1e-9)) {
                 write_frame();
                 // The next frame time after now (a step longer than 1/fps skips frame times).

@@ -50,6 +50,10 @@ struct Scene {
     bool walls = true;                   // boundary.walls: line the domain with static boundary particles
     Real boundary_spacing_factor = 0.5;  // boundary spacing = factor × r0
     int boundary_layers = 1;
+    // boundary.max_lost_fraction: the run stops (exit 4) once more than this share of the fluid has
+    // left the domain. With walls a loss means a leak or a blow-up, so the default is 1%; an open
+    // domain (walls false) lets fluid out by design, so there it defaults to 1 (never stop).
+    double max_lost_fraction = 0.01;
     std::vector<FluidBlock> fluid_blocks;
     std::vector<StaticBox> static_boxes;
     std::vector<SceneObject> objects;

@@ -514,3 +514,36 @@ TEST_CASE("guards: particles leaving an open domain are counted and reported") {
     CHECK(s["lost_particles"].get<long>() > 0);
     CHECK(contains(r.err, "left the domain"));
 }
+
+TEST_CASE("guards: a run that loses more fluid through its walls than boundary.max_lost_fraction stops") {
+    // 20 m/s at dt 2 ms is two particle spacings a step: the block punches through the floor.
+    const std::string through_floor = " --set 'fluid_blocks.0.velocity=[0,-20,0]' --set 'output.formats=[]'";
+    SUBCASE("with walls the default (1%) stops it, naming the step, the count and the key") {
+        const std::string dir = out_dir("lost_walls");
+        const Result r = run("run " + tiny() + " --steps 10 --quiet --out " + dir + through_floor);
+        CAPTURE(r.err);
+        CHECK(r.code == 4);
+        CHECK(contains(r.err, "of 125 fluid particles"));
+        CHECK(contains(r.err, "more than boundary.max_lost_fraction 0.01"));
+        const auto s = read_json(dir + "/summary.json");
+        CHECK(s["status"] == "failed");
+        CHECK(s["steps"].get<long>() < 10);  // stopped at the step that crossed the limit
+        CHECK(s["lost_particles"].get<long>() > 125 / 100);
+        CHECK(s["scene"]["boundary"]["max_lost_fraction"].get<double>() == doctest::Approx(0.01));
+    }
+    SUBCASE("a limit of 1 lets the run finish, with the warning") {
+        const std::string dir = out_dir("lost_allowed");
+        const Result r =
+            run("run " + tiny() + " --steps 3 --out " + dir + through_floor + " --set boundary.max_lost_fraction=1");
+        CAPTURE(r.err);
+        CHECK(r.code == 0);
+        CHECK(contains(r.err, "left the domain"));
+        CHECK(read_json(dir + "/summary.json")["status"] == "completed");
+    }
+    SUBCASE("out of range") {
+        const Result r = run("run " + tiny() + " --steps 1 --out " + out_dir("lost_range") +
+                             " --set boundary.max_lost_fraction=1.5");
+        CHECK(r.code != 0);
+        CHECK(contains(r.err, "boundary.max_lost_fraction"));
+    }
+}
