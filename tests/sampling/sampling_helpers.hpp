@@ -1,9 +1,13 @@
-// Shared bits of the sampling tests: where the real meshes live, and a skip helper.
+// Shared bits of the sampling tests: where the real meshes live, a skip helper, the error a call
+// throws, and a small OBJ tetrahedron to break in different ways.
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include <doctest/doctest.h>
+
+#include "backend/errors.hpp"
 
 namespace mwtest {
 inline std::string mesh_dir() { return std::string(MW_SHARED_DIR) + "/assets/meshes"; }
@@ -14,4 +18,18 @@ inline bool missing_mesh(const std::string& file) {
     MESSAGE("SKIPPED: " << path << " is absent (the shared meshes live in ../shared/assets/meshes)");
     return true;
 }
+
+// The InputError message `f` throws, or "" when it throws none.
+inline std::string error_of(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const mw::InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+// The unit tetrahedron as OBJ text, faces wound outward.
+inline const std::string kTetVertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+inline const std::string kTetFaces = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
 }  // namespace mwtest

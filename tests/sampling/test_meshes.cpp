@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <string>
 
 #include <doctest/doctest.h>
@@ -16,6 +15,7 @@
 #include "sampling_helpers.hpp"
 
 using namespace mw;
+using mwtest::error_of;
 
 namespace {
 void check_closed_outward(const TriangleMesh& m, double expected_volume, double rel_tol) {
@@ -25,14 +25,6 @@ void check_closed_outward(const TriangleMesh& m, double expected_volume, double 
     CHECK(e.misoriented_edges == 0);
     CHECK(signed_volume(m) == doctest::Approx(expected_volume).epsilon(rel_tol));
     CHECK_NOTHROW(validate_mesh(m, true));
-}
-std::string error_of(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
 }
 }  // namespace
 
@@ -101,7 +93,7 @@ TEST_CASE("OBJ input: polygons are triangulated") {
 }
 
 TEST_CASE("bad mesh input gives one clear error naming the file and the problem") {
-    const std::string tet_faces = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    const std::string& tet_faces = mwtest::kTetFaces;
     CHECK(error_of([] { load_obj("/nonexistent/dir/missing.obj"); }) ==
           "/nonexistent/dir/missing.obj: mesh file does not exist");
     CHECK(error_of([] { load_obj(std::filesystem::temp_directory_path().string()); }).find("not a regular file") !=
@@ -132,8 +124,8 @@ TEST_CASE("bad mesh input gives one clear error naming the file and the problem"
 }
 
 TEST_CASE("malformed OBJ lines are named by their line, never misreported or dropped") {
-    const std::string tet_vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
-    const std::string tet_faces = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    const std::string& tet_vertices = mwtest::kTetVertices;
+    const std::string& tet_faces = mwtest::kTetFaces;
     auto error = [](const std::string& text) { return error_of([&] { parse_obj(text, "m.obj"); }); };
     // Too few coordinates: tinyobjloader would read the missing z as 0.
     CHECK(error("v 0 0 0\nv 1 0\nv 0 1 0\nv 0 0 1\n" + tet_faces) ==

@@ -2,7 +2,6 @@
 // inside/outside test on closed and open meshes.
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <set>
 #include <string>
 
@@ -295,14 +294,7 @@ TEST_CASE("inside/outside does not depend on the mesh's scale (the ray tracer wo
 
 TEST_CASE("spacings the ray tracer cannot handle are refused with one line, never an abort") {
     const TriangleMesh sphere = make_sphere(1.0, 3);
-    auto error_of = [](const std::function<void()>& f) -> std::string {
-        try {
-            f();
-        } catch (const InputError& e) {
-            return e.what();
-        }
-        return "";
-    };
+    using mwtest::error_of;
     // Larger than the mesh: the lattice lines would start 1e20 away, which made Embree assert.
     CHECK(error_of([&] { sample_solid(sphere, 1e20, 2.5e20); }).find("is larger than the mesh itself") != std::string::npos);
     CHECK(error_of([&] { sample_solid(sphere, 2.5, 6); }).find("is larger than the mesh itself") != std::string::npos);

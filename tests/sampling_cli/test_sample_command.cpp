@@ -14,6 +14,8 @@
 #include <sstream>
 #include <string>
 
+#include "tests/sampling/sampling_helpers.hpp"
+
 namespace {
 
 struct Run {
@@ -105,8 +107,8 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
         return "'" + (dir / name).string() + "'";
     };
     const std::string out = " --out '" + (dir / "out").string() + "'";
-    const std::string tet_vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
-    const std::string tet = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    const std::string& tet_vertices = mwtest::kTetVertices;
+    const std::string& tet = mwtest::kTetFaces;
     struct Case {
         std::string args, expect;
     };
