@@ -160,21 +160,13 @@ namespace {
 // A 10 x 10 x 10 block of fluid at r0 = 0.02 alone in a 1 m box (no walls), every particle at
 // `velocity`; CFL time steps (cfl 0.4, largest step 0.01 s), no gravity unless asked.
 SimulationSetup free_block_cfl(Vec3 velocity, Vec3 gravity = Vec3{0, 0, 0}) {
-    SimulationSetup setup;
-    setup.params.domain_min = {0, 0, 0};
-    setup.params.domain_max = {1, 1, 1};
+    SimulationSetup setup =
+        test::fluid_in_box({0, 0, 0}, {1, 1, 1}, {0.3f, 0.3f, 0.3f}, {0.5f, 0.5f, 0.5f}, 0.02f, 0.01f, false);
     setup.params.gravity = gravity;
-    setup.params.fluid.spacing = 0.02f;
-    setup.params.fluid.support_radius = 0.04f;
-    setup.params.fluid.rest_density = 1000;
     setup.params.solver.dt_mode = TimeStepMode::kCfl;
     setup.params.solver.cfl_number = 0.4f;
-    setup.params.solver.dt = 0.01f;
     setup.params.solver.dt_min = 1e-6f;
-    setup.position = fill_box_lattice({0.3f, 0.3f, 0.3f}, {0.5f, 0.5f, 0.5f}, 0.02f);
     setup.velocity.assign(setup.position.size(), velocity);
-    setup.type.assign(setup.position.size(), kFluid);
-    setup.object.assign(setup.position.size(), -1);
     return setup;
 }
 // Steps the simulation, returns the reported steps; checks that time() is their sum.

@@ -15,8 +15,10 @@
 namespace mw::test {
 
 // A box of fluid [block_lo, block_hi] in a domain [lo, hi] lined with Akinci walls at spacing r0/2,
-// the first layer kWallGap r0 outside the faces (the fluid starts at rest density).
-inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_hi, Real r0, Real dt) {
+// the first layer kWallGap r0 outside the faces (the fluid starts at rest density); `walls` false
+// leaves the domain open.
+inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_hi, Real r0, Real dt,
+                                    bool walls = true) {
     SimulationSetup setup;
     setup.params.domain_min = lo;
     setup.params.domain_max = hi;
@@ -28,9 +30,11 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
         setup.position.push_back(p);
         setup.type.push_back(kFluid);
     }
-    for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, kWallGap * r0)) {
-        setup.position.push_back(p);
-        setup.type.push_back(kStaticBoundary);
+    if (walls) {
+        for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, kWallGap * r0)) {
+            setup.position.push_back(p);
+            setup.type.push_back(kStaticBoundary);
+        }
     }
     setup.velocity.assign(setup.position.size(), Vec3{0, 0, 0});
     setup.object.assign(setup.position.size(), -1);
