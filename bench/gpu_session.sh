@@ -10,10 +10,12 @@
 # Usage: bench/gpu_session.sh STAGE...   stages, in the order given:
 #   unpack    unpack the bundle into build-gpu/, check the libraries (ldd), nvidia-smi,
 #             `meltwater backends`, and a 20-step dam break on CUDA (MELTWATER_CUDA_SYNC=1)
-#   test      every test program (tests.txt), first with MELTWATER_CUDA_SYNC=1, then the CUDA cases
-#             again without it; each program's doctest summary
+#   test      the CUDA cases and test_cli with MELTWATER_CUDA_SYNC=1, the CUDA cases again without
+#             it, then the rest of every test program (tests.txt) while time remains; each
+#             program's doctest summary
 #   sanitize  compute-sanitizer memcheck and initcheck: hydrostatic column (grid gathers; then
-#             neighbour lists and viscosity), the cantilever (solids), test_cuda_backend
+#             neighbour lists and viscosity), the cantilever (solids), the cantilever in a pool
+#             (fluid and a moving solid, viscosity, linear cell order), test_cuda_backend
 #   bench     bench/run_benchmarks.sh build-gpu --large, CUDA only (BENCH_BACKENDS=cuda)
 #   ncu       a 1M-particle dam break, 3 steps: every kernel's time, then `--set basic` on the
 #             five kernels that take the most time
@@ -50,7 +52,7 @@ failed=0
 bundle_ready=""
 gpu=""
 
-[[ $# -gt 0 ]] || { sed -n '2,27p' "$0"; exit 2; }
+[[ $# -gt 0 ]] || { sed -n '2,28p' "$0"; exit 2; }
 for s in "$@"; do
   case "$s" in unpack | test | sanitize | bench | ncu) ;; *) echo "gpu_session: unknown stage '$s'" >&2; exit 2 ;; esac
 done
@@ -227,17 +229,31 @@ run_test_program() {
 stage_test() {
   ensure_bundle || return
   [[ -n "$gpu" ]] || say "no usable CUDA device: the CUDA cases skip with a message"
-  say "-- pass 1, MELTWATER_CUDA_SYNC=1 (synchronise and check after every launch)"
+  # What only this machine can check comes first, so that a short call still does it: the CUDA
+  # cases, and the command line's tests (their runs pick CUDA here through --backend auto).
+  say "-- pass 1, MELTWATER_CUDA_SYNC=1 (synchronise and check after every launch): the CUDA cases and test_cli"
+  [[ -x $build/test_cuda_backend ]] && MELTWATER_CUDA_SYNC=1 run_test_program test_cuda_backend "$work/test_cuda_backend.log"
+  MELTWATER_CUDA_SYNC=1 run_test_program test_core "$work/test_core-cuda.log" '-tc=CUDA*'
+  MELTWATER_CUDA_SYNC=1 run_test_program test_lsm "$work/test_lsm-cuda.log" '-tc=CUDA*'
+  MELTWATER_CUDA_SYNC=1 run_test_program test_cli "$work/test_cli.log"
+  if [[ -n "$gpu" ]]; then
+    if (($(time_left) < 120)); then say "pass 2 skipped: $(time_left) s left"; return; fi
+    say "-- pass 2, the CUDA cases without MELTWATER_CUDA_SYNC"
+    [[ -x $build/test_cuda_backend ]] && run_test_program test_cuda_backend "$work/test_cuda_backend-nosync.log"
+    run_test_program test_core "$work/test_core-cuda-nosync.log" '-tc=CUDA*'
+    run_test_program test_lsm "$work/test_lsm-cuda-nosync.log" '-tc=CUDA*'
+  fi
+  # The rest of the suite (CPU cases) on this machine's cores, while time remains.
+  if (($(time_left) < 150)); then say "pass 3 (the CPU cases) skipped: $(time_left) s left"; return; fi
+  say "-- pass 3, the other cases (OpenMP and the sampler)"
   local name
   for name in $(cat $build/tests.txt 2>/dev/null || (cd $build && ls test_*)); do
-    MELTWATER_CUDA_SYNC=1 run_test_program "$name" "$work/$name.log"
+    case "$name" in
+      test_cuda_backend | test_cli) ;;
+      test_core | test_lsm) run_test_program "$name" "$work/$name-cpu.log" '-tce=CUDA*' ;;
+      *) run_test_program "$name" "$work/$name.log" ;;
+    esac
   done
-  [[ -n "$gpu" ]] || return
-  if (($(time_left) < 120)); then say "pass 2 skipped: $(time_left) s left"; return; fi
-  say "-- pass 2, the CUDA cases without MELTWATER_CUDA_SYNC"
-  [[ -x $build/test_cuda_backend ]] && run_test_program test_cuda_backend "$work/test_cuda_backend-nosync.log"
-  run_test_program test_core "$work/test_core-cuda-nosync.log" '-tc=CUDA*'
-  run_test_program test_lsm "$work/test_lsm-cuda-nosync.log" '-tc=CUDA*'
 }
 
 stage_sanitize() {
@@ -248,9 +264,12 @@ stage_sanitize() {
     [hydrostatic]="scenes/hydrostatic_column.json"
     [hydrostatic-lists-viscosity]="scenes/hydrostatic_column.json --set neighbors.lists=on --set fluid.viscosity=0.01"
     [cantilever]="scenes/cantilever.json"
+    # Fluid around a moving solid (boundary volumes of moving solids, the solid group in every
+    # gather), with viscosity and the linear cell order: paths the other cases leave out.
+    [beam-in-pool]="scenes/cantilever.json --set boundary.walls=true --set fluid_blocks=[{\"min\":[0.3,0.45,0.05],\"max\":[0.9,0.85,0.35]}] --set fluid.viscosity=0.01 --set fluid.wall_viscosity=0.01 --set neighbors.ordering=linear"
   )
   for tool in memcheck initcheck; do
-    for name in hydrostatic hydrostatic-lists-viscosity cantilever; do
+    for name in hydrostatic hydrostatic-lists-viscosity cantilever beam-in-pool; do
       rm -rf /tmp/meltwater-gpu-san
       # shellcheck disable=SC2086
       run_logged "$work/$tool-$name.log" "$(budget 150)" compute-sanitizer --tool $tool --error-exitcode 9 \

@@ -29,13 +29,18 @@ void check_launch(const char* name) {
     if (debug_sync_enabled()) check_cuda(cudaDeviceSynchronize(), name);
 }
 
-bool backend_available() {
+bool backend_available() { return unavailable_reason().empty(); }
+
+std::string unavailable_reason() {
     int count = 0;
-    if (cudaGetDeviceCount(&count) != cudaSuccess) {
-        (void)cudaGetLastError();
-        return false;
-    }
-    return count > 0;
+    const cudaError_t status = cudaGetDeviceCount(&count);
+    if (status == cudaSuccess) return count > 0 ? std::string() : std::string("no CUDA device found");
+    (void)cudaGetLastError();
+    // The runtime reports a machine with no driver at all as an insufficient driver.
+    if (status == cudaErrorInsufficientDriver)
+        return "no CUDA driver, or one older than this build's CUDA runtime (cudaErrorInsufficientDriver)";
+    if (status == cudaErrorNoDevice) return "no CUDA device found";
+    return std::string("no usable CUDA device: ") + cudaGetErrorString(status) + " (" + cudaGetErrorName(status) + ")";
 }
 
 std::string device_description() {

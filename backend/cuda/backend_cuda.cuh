@@ -44,6 +44,7 @@ inline MemoryLedger& memory_ledger() {
 void set_threads(int threads);  // no effect on the GPU; kept for a uniform command line
 int thread_count();
 bool backend_available();          // a CUDA device is present and usable
+std::string unavailable_reason();  // why not, in the driver's words ("" when available)
 std::string device_description();  // e.g. "NVIDIA H100 80GB HBM3 (sm_90, 79.1 GiB)"
 std::int64_t device_memory_free();
 int multiprocessor_count();  // of the current device, read once
@@ -146,7 +147,13 @@ struct IndexTransform {
 template <class T, class Op, class F>
 T transform_reduce(const char* name, std::size_t n, T identity, Op op, F f) {
     if (n == 0) return identity;
-    static DeviceArray<T> device_result(1);
+    // Zeroed once: CUB writes only T's members, and copying back padding it never wrote (a float
+    // build's DensityError) would be an uninitialised read to compute-sanitizer's initcheck.
+    static DeviceArray<T> device_result = [] {
+        DeviceArray<T> result(1);
+        check_cuda(cudaMemset(result.view().data(), 0, sizeof(T)), "reduction result");
+        return result;
+    }();
     device_result.resize(1);
     thrust::counting_iterator<std::size_t> first(0);
     IndexTransform<T, F> transform{f};

@@ -6,13 +6,16 @@
 namespace mw {
 
 BackendInfo cuda_backend_info() {
-    const bool available = cuda_backend::backend_available();
-    return BackendInfo{"cuda", true, available, available ? cuda_backend::device_description() : "compiled, but no CUDA device found",
+    const std::string why_not = cuda_backend::unavailable_reason();
+    const bool available = why_not.empty();
+    return BackendInfo{"cuda", true, available,
+                       available ? cuda_backend::device_description() : "compiled, but " + why_not,
                        cuda_backend::kPrefersNeighborLists};
 }
 
 std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup) {
-    if (!cuda_backend::backend_available()) throw DeviceError("the CUDA backend was requested but no CUDA device was found");
+    const std::string why_not = cuda_backend::unavailable_reason();
+    if (!why_not.empty()) throw DeviceError("the CUDA backend was requested but is unusable: " + why_not);
     // The command line adds the scene's particle count and memory estimate to a DeviceError.
     return std::make_unique<cuda_backend::BackendSimulation>(setup);
 }

@@ -350,7 +350,7 @@ TEST_CASE("the resolved scene names mesh files absolutely, so it runs from anywh
 
 TEST_CASE("run: two steps write frames, stats.csv and summary.json") {
     const std::string dir = out_dir("two_steps");
-    const Result r = run("run " + tiny() + " --steps 2 --threads 1 --out " + dir + " --set solver.eta=0.02");
+    const Result r = run("run " + tiny() + " --steps 2 --backend openmp --threads 1 --out " + dir + " --set solver.eta=0.02");
     CAPTURE(r.err);
     CAPTURE(r.out);
     REQUIRE(r.code == 0);

@@ -10,7 +10,7 @@
 namespace {
 bool gpu_present() {
     if (mw::backend_available()) return true;
-    MESSAGE("SKIPPED: no CUDA device found");
+    MESSAGE("SKIPPED: no usable CUDA device (" << mw::unavailable_reason() << ")");
     return false;
 }
 }  // namespace
