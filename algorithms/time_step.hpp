@@ -86,7 +86,8 @@ class BackendSimulation final : public Simulation {
             }
             timers_.stop(kPcisph);
             // After a retry the next steps start from the step that held and grow back gradually.
-            retry_dt_limit_ = retries > 0 ? double(dt) : std::min(1e300, retry_dt_limit_ * kRetryGrowth);
+            update_retry_growth(retries > 0);
+            retry_dt_limit_ = retries > 0 ? double(dt) : std::min(1e300, retry_dt_limit_ * retry_growth_);
         }
 
         // 5. Coupling forces on solids go here (they fill solids_.force()).
@@ -194,16 +195,43 @@ class BackendSimulation final : public Simulation {
         const SolverParams& solver = params_.solver;
         if (solver.dt_mode == TimeStepMode::kFixed) return solver.dt;
         const Real largest = static_cast<Real>(std::min(double(solver.dt), retry_dt_limit_));
-        if (last_max_speed_ <= 0) return largest;
-        const Real cfl_dt = solver.cfl_number * params_.fluid.spacing / static_cast<Real>(last_max_speed_);
+        // The largest Δt in which a particle at the last step's top speed v, gaining g Δt on the
+        // way, moves at most cfl r0: (v + g Δt) Δt = cfl r0, so Δt = 2 cfl r0 / (v + √(v² + 4 g cfl r0)).
+        // Speed alone (cfl r0 / v) would let a fluid at rest take the largest step, and a column
+        // falls g Δt², 2.5 r0 in 50 ms at r0 = 0.01 m: through its floor's wall in the first step.
+        const double reach = double(solver.cfl_number) * double(params_.fluid.spacing);
+        const double g = double(norm(params_.gravity));
+        const double v = last_max_speed_;
+        const double denominator = v + std::sqrt(v * v + 4 * g * reach);
+        if (!(denominator > 0)) return largest;
+        const Real cfl_dt = static_cast<Real>(2 * reach / denominator);
         // The floor never lifts the step above the scene's largest step.
         return std::max(std::min(solver.dt_min, largest), std::min(largest, cfl_dt));
     }
     // Retries of a diverging PCISPH step at half the step (CFL mode): at most 6, down to 1/64 of
     // the step first chosen and never below min(dt_min, dt); after one, the largest step grows
-    // back by a quarter per step.
+    // back by at most a quarter per step.
     static constexpr int kMaxRetries = 6;
     static constexpr double kRetryGrowth = 1.25;
+    // The growth adapts to how often steps diverge: a retry within kRetryWindow steps of the last
+    // halves the growth's excess over 1 (down to kRetryGrowthLeast), and every kRetryWindow steps
+    // without one double it back (up to kRetryGrowth). A resting column 20 layers deep at a largest
+    // step of 0.01 s had retried 109 of 478 steps, the failed tries taking 48% of all iterations;
+    // with this, 30 retries and 23% fewer iterations, while a dam break's isolated retries keep the
+    // quick growth (docs/solver.md, "A column at rest far beyond its step").
+    static constexpr int kRetryWindow = 20;
+    static constexpr double kRetryGrowthLeast = 1.01;
+    void update_retry_growth(bool retried) {
+        if (retried) {
+            if (steps_since_retry_ < kRetryWindow)
+                retry_growth_ = std::max(kRetryGrowthLeast, 1 + (retry_growth_ - 1) / 2);
+            steps_since_retry_ = 0;
+        } else if (++steps_since_retry_ % kRetryWindow == 0) {
+            retry_growth_ = std::min(kRetryGrowth, 1 + (retry_growth_ - 1) * 2);
+        }
+    }
+    double retry_growth_ = kRetryGrowth;
+    long steps_since_retry_ = kRetryWindow;  // no retry yet
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
