@@ -99,8 +99,11 @@ void* pinned_scratch(std::size_t bytes) {
     static std::size_t capacity = 0;
     if (bytes > capacity) {
         if (buffer) cudaFreeHost(buffer);
-        capacity = bytes < 256 ? 256 : bytes;
-        check_cuda(cudaMallocHost(&buffer, capacity), "pinned_scratch");
+        buffer = nullptr;
+        capacity = 0;  // until the new buffer exists: a failed allocation must not hand out the freed one
+        const std::size_t wanted = bytes < 256 ? 256 : bytes;
+        check_cuda(cudaMallocHost(&buffer, wanted), "pinned_scratch");
+        capacity = wanted;
     }
     return buffer;
 }
@@ -117,6 +120,7 @@ void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::u
     check_cuda(cub::DeviceRadixSort::SortPairs(temp, temp_bytes, keys_in.data(), keys_out.data(), values_in.data(),
                                                values_out.data(), n, 0, key_bits),
                name);
+    check_launch(name);  // under MELTWATER_CUDA_SYNC a fault in the sort is reported as the sort's
 }
 
 StageTimers::StageTimers(int stage_count) : start_(stage_count), stop_(stage_count), used_(stage_count, 0) {
