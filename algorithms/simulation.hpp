@@ -27,7 +27,7 @@ struct FluidParams {
 struct SolverParams {
     Real dt = 0.001;                         // s: the fixed step, or the largest step in CFL mode
     TimeStepMode dt_mode = TimeStepMode::kFixed;
-    Real cfl_number = 0.4;                   // Δt ≤ cfl · r0 / v_max in CFL mode
+    Real cfl_number = 0.4;                   // CFL mode: a particle moves at most cfl · r0 a step (step_size.hpp)
     Real dt_min = 1e-6;                      // CFL mode never goes below min(this, dt)
     Real eta = 0.01;                         // PCISPH stops when the average density error < η
     Real eta_max = 0;                        // ... and, when positive, the largest one < eta_max

@@ -16,6 +16,7 @@
 #include "algorithms/pcisph_delta.hpp"
 #include "algorithms/simulation.hpp"
 #include "algorithms/solid_bodies.hpp"
+#include "algorithms/step_size.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -24,7 +25,7 @@ class BackendSimulation final : public Simulation {
     explicit BackendSimulation(const SimulationSetup& setup);
 
     void step() override {
-        Real dt = choose_time_step();
+        Real dt = step_size_.next(params_, last_max_speed_);
 
         // 1. Neighbour search: sort moving particles by cell, permute every field, cell ranges.
         timers_.start(kNeighbors);
@@ -70,7 +71,6 @@ class BackendSimulation final : public Simulation {
         DensityError error;
         if (has_fluid_) {
             timers_.start(kPcisph);
-            const Real smallest_dt = std::min(params_.solver.dt_min, params_.solver.dt);
             for (;;) {
                 const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
                 int tried = 0;
@@ -78,16 +78,13 @@ class BackendSimulation final : public Simulation {
                             ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, tried, diverged)
                             : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, tried, diverged);
                 iterations += tried;
-                if (!diverged || params_.solver.dt_mode != TimeStepMode::kCfl || retries == kMaxRetries ||
-                    Real(0.5) * dt < smallest_dt)
-                    break;
+                if (!diverged || !StepSizeControl::may_retry(params_.solver, retries, dt)) break;
                 dt *= Real(0.5);
                 ++retries;
             }
             timers_.stop(kPcisph);
             // After a retry the next steps start from the step that held and grow back gradually.
-            update_retry_growth(retries > 0);
-            retry_dt_limit_ = retries > 0 ? double(dt) : std::min(1e300, retry_dt_limit_ * retry_growth_);
+            step_size_.after_step(retries, dt);
         }
 
         // 5. Coupling forces on solids go here (they fill solids_.force()).
@@ -191,48 +188,6 @@ class BackendSimulation final : public Simulation {
     static constexpr const char* kStageNames[kStageCount] = {"neighbors", "solid_volumes", "viscosity",
                                                              "pcisph",    "lsm",           "integrate"};
 
-    Real choose_time_step() const {
-        const SolverParams& solver = params_.solver;
-        if (solver.dt_mode == TimeStepMode::kFixed) return solver.dt;
-        const Real largest = static_cast<Real>(std::min(double(solver.dt), retry_dt_limit_));
-        // The largest Δt in which a particle at the last step's top speed v, gaining g Δt on the
-        // way, moves at most cfl r0: (v + g Δt) Δt = cfl r0, so Δt = 2 cfl r0 / (v + √(v² + 4 g cfl r0)).
-        // Speed alone (cfl r0 / v) would let a fluid at rest take the largest step, and a column
-        // falls g Δt², 2.5 r0 in 50 ms at r0 = 0.01 m: through its floor's wall in the first step.
-        const double reach = double(solver.cfl_number) * double(params_.fluid.spacing);
-        const double g = double(norm(params_.gravity));
-        const double v = last_max_speed_;
-        const double denominator = v + std::sqrt(v * v + 4 * g * reach);
-        if (!(denominator > 0)) return largest;
-        const Real cfl_dt = static_cast<Real>(2 * reach / denominator);
-        // The floor never lifts the step above the scene's largest step.
-        return std::max(std::min(solver.dt_min, largest), std::min(largest, cfl_dt));
-    }
-    // Retries of a diverging PCISPH step at half the step (CFL mode): at most 6, down to 1/64 of
-    // the step first chosen and never below min(dt_min, dt); after one, the largest step grows
-    // back by at most a quarter per step.
-    static constexpr int kMaxRetries = 6;
-    static constexpr double kRetryGrowth = 1.25;
-    // The growth adapts to how often steps diverge: a retry within kRetryWindow steps of the last
-    // halves the growth's excess over 1 (down to kRetryGrowthLeast), and every kRetryWindow steps
-    // without one double it back (up to kRetryGrowth). A resting column 20 layers deep at a largest
-    // step of 0.01 s had retried 109 of 478 steps, the failed tries taking 48% of all iterations;
-    // with this, 30 retries and 23% fewer iterations, while a dam break's isolated retries keep the
-    // quick growth (docs/solver.md, "A column at rest far beyond its step").
-    static constexpr int kRetryWindow = 20;
-    static constexpr double kRetryGrowthLeast = 1.01;
-    void update_retry_growth(bool retried) {
-        if (retried) {
-            if (steps_since_retry_ < kRetryWindow)
-                retry_growth_ = std::max(kRetryGrowthLeast, 1 + (retry_growth_ - 1) / 2);
-            steps_since_retry_ = 0;
-        } else if (++steps_since_retry_ % kRetryWindow == 0) {
-            retry_growth_ = std::min(kRetryGrowth, 1 + (retry_growth_ - 1) * 2);
-        }
-    }
-    double retry_growth_ = kRetryGrowth;
-    long steps_since_retry_ = kRetryWindow;  // no retry yet
-
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
         double stage_ms[kStageCount];
@@ -295,7 +250,7 @@ class BackendSimulation final : public Simulation {
     double time_ = 0;
     long step_ = 0;
     double last_max_speed_ = 0;
-    double retry_dt_limit_ = 1e300;  // CFL mode: largest step after a retry (grows back)
+    StepSizeControl step_size_;  // CFL mode: the bound, and the limit PCISPH retries set
     StepReport report_;
 };
 

@@ -271,9 +271,11 @@ stage_sanitize() {
   for tool in memcheck initcheck; do
     for name in hydrostatic hydrostatic-lists-viscosity cantilever beam-in-pool; do
       rm -rf /tmp/meltwater-gpu-san
-      # shellcheck disable=SC2086
+      # Split on spaces only: the JSON of beam-in-pool must not be read as a glob pattern.
+      local -a scene_args
+      read -ra scene_args <<<"${cases[$name]}"
       run_logged "$work/$tool-$name.log" "$(budget 150)" compute-sanitizer --tool $tool --error-exitcode 9 \
-        --print-limit 30 $build/meltwater run ${cases[$name]} --backend cuda --steps 5 \
+        --print-limit 30 $build/meltwater run "${scene_args[@]}" --backend cuda --steps 5 \
         --set 'output.formats=[]' --out /tmp/meltwater-gpu-san --quiet
       rc=$?
       local errs

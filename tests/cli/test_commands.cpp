@@ -144,7 +144,7 @@ TEST_CASE("bad input: a scene larger than the host's memory is refused before al
     while (std::getline(meminfo, line))
         if (std::sscanf(line.c_str(), "MemAvailable: %lf kB", &available_kib) == 1) break;
     if (available_kib == 0 || available_kib > 60e6) {
-        MESSAGE("MemAvailable unknown or above 60 GB: the host-memory refusal is not tested here");
+        MESSAGE("SKIPPED: MemAvailable unknown or above 60 GB: the host-memory refusal is not tested here");
         return;
     }
     const std::string huge = "--set fluid.spacing=0.00036 --set 'fluid_blocks.0.max=[0.2,0.2,0.2]' --set fluid.support_radius=0.00072";
@@ -162,7 +162,7 @@ TEST_CASE("--backend cuda without a usable GPU is a clear error") {
     for (const auto& e : j["backends"])
         if (e["name"] == "cuda") cuda_available = e["available"].get<bool>();
     if (cuda_available) {
-        MESSAGE("a GPU is available here; the no-GPU error is not tested");
+        MESSAGE("SKIPPED: a GPU is available here; the no-GPU error is not tested");
         return;
     }
     check_rejected(run("run " + tiny() + " --steps 1 --backend cuda --out " + out_dir("cuda")), {"cuda"}, 3);

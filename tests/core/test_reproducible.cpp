@@ -185,8 +185,14 @@ std::vector<StepReport> cfl_steps(const SimulationSetup& setup, int steps) {
 }
 }  // namespace
 
+namespace {
+constexpr double cfl_r0 = 0.4 * 0.02;  // free_block_cfl's cfl_number times r0
+// The CFL bound under gravity 9.81 m/s²: the Δt with (v + g Δt) Δt = cfl r0.
+double cfl_bound_under_gravity(double v) { return 2 * cfl_r0 / (v + std::sqrt(v * v + 4 * 9.81 * cfl_r0)); }
+}  // namespace
+
 TEST_CASE("CFL time steps follow the last step's largest speed and gravity, capped at dt and floored at dt_min") {
-    const double cfl_r0 = 0.4 * 0.02;  // without gravity Δt = cfl r0 / v_max
+    // Without gravity Δt = cfl r0 / v_max.
     // Float parameters (0.4f * 0.02f / v in float): agreement to a few float roundings.
     const double rounding = 1e-6;
 
@@ -238,8 +244,7 @@ TEST_CASE("CFL time steps follow the last step's largest speed and gravity, capp
         double v = 0;
         int cfl_limited = 0;
         for (const StepReport& report : r) {
-            const double bound = 2 * cfl_r0 / (v + std::sqrt(v * v + 4 * 9.81 * cfl_r0));
-            const double dt = std::min(0.01, std::max(1e-6, bound));
+            const double dt = std::min(0.01, std::max(1e-6, cfl_bound_under_gravity(v)));
             cfl_limited += dt < 0.01;
             v += 9.81 * dt;
             // Float velocities summed over 30 steps: relative rounding of order 30 x 6e-8.
@@ -279,9 +284,7 @@ TEST_CASE("CFL retries: the largest step grows back by at most a quarter, by les
         // and 1.125 for the 20 steps after a retry that came within 20 steps of the one before.
         if (k == 0) continue;
         const double v_before = k >= 2 ? r[k - 2].max_speed : 0.0;
-        const double reach = 0.4 * 0.02;
-        const double bound_before = 2 * reach / (v_before + std::sqrt(v_before * v_before + 4 * 9.81 * reach));
-        if (r[k - 1].dt > bound_before * (1 - 1e-5)) continue;  // the step before was CFL-bound
+        if (r[k - 1].dt > cfl_bound_under_gravity(v_before) * (1 - 1e-5)) continue;  // it was CFL-bound
         const double growth = r[k].dt / r[k - 1].dt;
         ++checked;
         CHECK(growth <= 1.25 * (1 + 1e-6));

@@ -164,7 +164,7 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
 
 TEST_CASE("meshes of any size: the ray tracer's float range no longer hangs or exhausts memory") {
     const auto dir = temp_dir("scale");
-    std::ofstream(dir / "tet.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    std::ofstream(dir / "tet.obj") << mwtest::kTetVertices << mwtest::kTetFaces;
     const struct {
         std::string args, counts;
     } cases[] = {
