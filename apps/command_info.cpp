@@ -84,14 +84,20 @@ int command_info(int argc, char** argv) {
     std::printf("fluid       r0 %g m, h %g m, rest density %g kg/m3, viscosity %g Pa s, wall viscosity %g Pa s%s\n",
                 double(f.spacing), double(f.support_radius), double(f.rest_density), double(f.viscosity),
                 double(f.wall_viscosity), runs_viscosity ? "" : " (viscosity stage off)");
+    char stopping_rule[96];
+    if (solver.eta_max > 0)
+        std::snprintf(stopping_rule, sizeof stopping_rule, "density error < %g average, < %g peak", double(solver.eta),
+                      double(solver.eta_max));
+    else
+        std::snprintf(stopping_rule, sizeof stopping_rule, "density error < %g average (peak unbounded)", double(solver.eta));
     if (cfl)
-        std::printf("solver      CFL time step (number %g, at most %g s), eta %g, %d..%d iterations\n",
-                    double(solver.cfl_number), double(solver.dt), double(solver.eta), solver.min_iterations,
+        std::printf("solver      CFL time step (number %g, at most %g s), %s, %d..%d iterations\n",
+                    double(solver.cfl_number), double(solver.dt), stopping_rule, solver.min_iterations,
                     solver.max_iterations);
     else
-        std::printf("solver      fixed time step %g s (%ld steps to t=%g s), eta %g, %d..%d iterations\n",
+        std::printf("solver      fixed time step %g s (%ld steps to t=%g s), %s, %d..%d iterations\n",
                     double(solver.dt), static_cast<long>(std::ceil(scene.end_time / solver.dt - 1e-9)), scene.end_time,
-                    double(solver.eta), solver.min_iterations, solver.max_iterations);
+                    stopping_rule, solver.min_iterations, solver.max_iterations);
     std::printf("run         to t=%g s; %ld frames (%g per simulated second)\n", scene.end_time, frames, scene.fps);
     std::printf("boundary    %s, %d layer(s) at %g m; %zu static box(es)\n",
                 scene.walls ? "domain walls" : "no domain walls", scene.boundary_layers,

@@ -375,8 +375,9 @@ void read_solver(Section s, Scene& scene) {
     p.dt = Real(s.number("dt", 0.001, Range{1e-7, 1, false, false}));
     p.dt_mode = s.choice("dt_mode", "fixed", {"fixed", "cfl"}) == "cfl" ? TimeStepMode::kCfl : TimeStepMode::kFixed;
     p.cfl_number = Real(s.number("cfl_number", 0.4, Range{0, 1, true, false}));
-    p.eta = Real(s.number("eta", 0.01, Range{0, 1, true, true}));
-    p.eta_max = Real(s.number("eta_max", 0.0, Range{0, 1, false, true}));
+    const double eta = s.number("eta", 0.01, Range{0, 1, true, true});
+    p.eta = Real(eta);
+    p.eta_max = Real(s.number("eta_max", default_eta_max(eta), Range{0, 1, false, true}));
     p.min_iterations = s.integer("min_iterations", 3, 1, 1000);
     p.max_iterations = s.integer("max_iterations", 100, 1, 10000);
     if (p.max_iterations < p.min_iterations)

@@ -202,6 +202,8 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(contains(d.out, "fluid 48,000"));
     CHECK(contains(d.out, "memory"));
     CHECK(contains(d.out, "stages"));
+    CHECK(contains(d.out, "density error < 0.01 average, < 0.05 peak"));  // the stopping rule, default peak bound
+    CHECK(contains(run("info --set solver.eta_max=0").out, "< 0.01 average (peak unbounded)"));
 
     const Result t = run("info " + tiny() + " --json");
     CAPTURE(t.err);

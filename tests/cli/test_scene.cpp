@@ -82,6 +82,7 @@ TEST_CASE("defaults are filled in and recorded in the resolved scene") {
     CHECK(s.params.gravity.y == doctest::Approx(-9.81));
     CHECK(s.params.solver.dt_mode == TimeStepMode::kFixed);
     CHECK(s.params.solver.eta == doctest::Approx(0.01));
+    CHECK(s.params.solver.eta_max == doctest::Approx(0.05));  // 5 eta
     CHECK(s.params.solver.min_iterations == 3);
     CHECK(s.params.solver.max_iterations == 100);
     CHECK(s.params.ordering == CellOrdering::kZOrder);
@@ -96,6 +97,7 @@ TEST_CASE("defaults are filled in and recorded in the resolved scene") {
     CHECK(r["fluid"]["support_radius"].get<double>() == doctest::Approx(0.04));
     CHECK(r["gravity"][1].get<double>() == doctest::Approx(-9.81));
     CHECK(r["solver"]["dt_mode"] == "fixed");
+    CHECK(r["solver"]["eta_max"].get<double>() == 0.05);  // computed in double: no float residue
     CHECK(r["neighbors"]["ordering"] == "zorder");
     CHECK(r["fluid_blocks"][0]["velocity"].size() == 3);
     CHECK(r["run"]["end_time"].get<double>() == doctest::Approx(1.0));
@@ -126,6 +128,12 @@ TEST_CASE("--set overrides reach every kind of key") {
     // A derived default follows its base when not given explicitly.
     const Scene t = parse_scene_text(tiny_scene_text(), "t", {"fluid.spacing=0.01"});
     CHECK(t.params.fluid.support_radius == doctest::Approx(0.02));
+    // So does the peak bound: 5 eta, and off where that would be 1 or more; 0 turns it off.
+    CHECK(s.params.solver.eta_max == doctest::Approx(0.025));
+    CHECK(parse_scene_text(tiny_scene_text(), "t", {"solver.eta=0.3"}).params.solver.eta_max == 0);
+    CHECK(parse_scene_text(tiny_scene_text(), "t", {"solver.eta_max=0"}).params.solver.eta_max == 0);
+    CHECK(parse_scene_text(tiny_scene_text(), "t", {"solver.eta=0.002", "solver.eta_max=0.03"}).params.solver.eta_max ==
+          doctest::Approx(0.03));
 }
 
 TEST_CASE("--set overrides that depend on each other are checked together, in any order") {
