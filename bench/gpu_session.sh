@@ -16,7 +16,8 @@
 #   sanitize  compute-sanitizer memcheck and initcheck: hydrostatic column (grid gathers; then
 #             neighbour lists and viscosity), the cantilever (solids), the cantilever in a pool
 #             (fluid and a moving solid, viscosity, linear cell order), test_cuda_backend
-#   bench     bench/run_benchmarks.sh build-gpu --large, CUDA only (BENCH_BACKENDS=cuda)
+#   bench     bench/run_benchmarks.sh build-gpu --large: the fluid benchmark on CUDA only
+#             (BENCH_BACKENDS=cuda), then bench_lsm (every backend) and bench_sampling
 #   ncu       a 1M-particle dam break, 3 steps: every kernel's time, then `--set basic` on the
 #             five kernels that take the most time
 # Every stage unpacks the bundle first if that is not done (a fresh machine, every call). Each
