@@ -14,9 +14,7 @@
 #include <string>
 
 #include "algorithms/sph_kernels.hpp"
-#include "apps/scene_builder.hpp"
 #include "backend/backend_registry.hpp"
-#include "sampling/procedural_meshes.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;
@@ -35,23 +33,15 @@ struct ColumnOnSlab {
                                    r0, 0.001f);
         setup.params.fluid.viscosity = 0.05f;  // damps the settling sloshing, as in test_hydrostatic
         setup.params.neighbor_lists = lists;
-        TriangleMesh slab = make_box(Vec3d(width, slab_top, width));
-        MeshTransform t;
-        t.translation = Vec3d(width / 2, slab_top / 2, width / 2);
-        apply_transform(slab, t);
         SolidSetup solid;
         solid.name = "slab";
         solid.kind = SolidKind::kElastic;
         solid.density = 1000;
-        const std::size_t before = setup.position.size();
-        add_solid_object(setup, slab, solid, Vec3{0, 0, 0}, 0, r0, setup.params.fluid.support_radius,
-                         [](const Vec3&) { return true; });
         // The block touches the slab: its first layer, r0/2 above the slab's surface particles,
         // is carved away as the scene builder does (a fluid layer that close to an Akinci layer
         // starts 55% over-dense and the first step blew the column apart).
-        const std::vector<std::uint8_t> removed =
-            carve_fluid(setup, Real(kFluidClearance) * r0, {}, before);
-        carved = std::count(removed.begin(), removed.end(), 1);
+        carved = test::add_box_solid(setup, Vec3d(width, slab_top, width), Vec3d(width / 2, slab_top / 2, width / 2),
+                                     solid, Vec3{0, 0, 0}, [](const Vec3&) { return true; });
         for (std::size_t i = 0; i < setup.position.size(); ++i) {
             if (setup.type[i] == kSurfaceBoundary || setup.type[i] == kInnerBoundary)
                 slab_particles.push_back(static_cast<std::uint32_t>(i));
@@ -136,18 +126,12 @@ SimulationSetup cube_into_pool(SimulationParams::Lists lists) {
         test::fluid_in_box({0, 0, 0}, {0.4f, 0.5f, 0.4f}, {0, 0, 0}, {0.4f, 0.2f, 0.4f}, r0, 0.002f);
     setup.params.fluid.viscosity = 0.01f;
     setup.params.neighbor_lists = lists;
-    TriangleMesh cube = make_box(Vec3d(0.12, 0.12, 0.12));
-    MeshTransform t;
-    t.translation = Vec3d(0.2, 0.27, 0.2);
-    apply_transform(cube, t);
     SolidSetup solid;
     solid.name = "cube";
     solid.kind = SolidKind::kElastic;
     solid.density = 1000;
     solid.stiffness = 0.5f;
-    const std::size_t before = setup.position.size();
-    add_solid_object(setup, cube, solid, Vec3{0, -1, 0}, 0, r0, setup.params.fluid.support_radius);
-    carve_fluid(setup, Real(kFluidClearance) * r0, {}, before);
+    test::add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.2, 0.27, 0.2), solid, Vec3{0, -1, 0});
     return setup;
 }
 }  // namespace
@@ -161,30 +145,21 @@ TEST_CASE("CUDA and OpenMP agree on fluid around a moving solid: a cube thrown i
         const std::string variant = lists == SimulationParams::Lists::kOn ? "neighbour lists" : "grid gathers";
         CAPTURE(variant);
         const SimulationSetup setup = cube_into_pool(lists);
-        auto cpu = create_openmp_simulation(setup, 0);
-        auto gpu = create_cuda_simulation(setup);
-        for (int s = 0; s < 40; ++s) {
-            cpu->step();
-            gpu->step();
-        }
-        HostParticles a, b;
-        cpu->download(a);
-        gpu->download(b);
+        const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 40);
+        const HostParticles &a = runs.openmp, &b = runs.cuda;
         REQUIRE(a.position.size() == b.position.size());
         const double domain_size = norm(setup.params.domain_max - setup.params.domain_min);
-        double worst_fluid = 0, worst_solid = 0, cube_bottom = 1;
-        for (std::size_t i = 0; i < a.position.size(); ++i) {
-            const double d = norm(a.position[i] - b.position[i]);
-            double& worst = a.type[i] == kFluid ? worst_fluid : worst_solid;
-            worst = std::max(worst, d);
+        const double worst_fluid = test::largest_position_difference(a, b, [](std::uint8_t t) { return t == kFluid; });
+        const double worst_solid = test::largest_position_difference(a, b, [](std::uint8_t t) { return t != kFluid; });
+        double cube_bottom = 1;
+        for (std::size_t i = 0; i < a.position.size(); ++i)
             if (a.type[i] == kInnerBoundary) cube_bottom = std::min(cube_bottom, double(a.position[i].y));
-        }
         MESSAGE("largest position difference after 40 steps: fluid " << worst_fluid << " m, solid " << worst_solid
                                                                       << " m");
         CHECK(worst_fluid < 1e-4 * domain_size);
         CHECK(worst_solid < 1e-4 * domain_size);
-        CHECK(cpu->last_report().lost_particles == 0);
-        CHECK(gpu->last_report().lost_particles == 0);
+        CHECK(runs.openmp_report.lost_particles == 0);
+        CHECK(runs.cuda_report.lost_particles == 0);
         // And the cube did go in: its lowest IBPs are below the pool's surface (0.2 m).
         CHECK(cube_bottom < 0.15);
     }

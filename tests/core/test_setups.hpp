@@ -3,14 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <vector>
 
 #include "algorithms/simulation.hpp"
 #include "algorithms/sph_kernels.hpp"
+#include "apps/scene_builder.hpp"
+#include "backend/backend_registry.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/kdtree.hpp"
+#include "sampling/procedural_meshes.hpp"
 
 namespace mw::test {
 
@@ -39,6 +43,64 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
     setup.velocity.assign(setup.position.size(), Vec3{0, 0, 0});
     setup.object.assign(setup.position.size(), -1);
     return setup;
+}
+
+// Adds a box of `size` centred on `centre` as a solid object (make_box, translated there) to a setup
+// of fluid_in_box: `solid` gives its name, kind, density and LSM settings; it is sampled at the
+// fluid's spacing r0 and support radius, its particles start at `velocity`, and IBPs for which
+// `pinned` is true stay at rest (add_solid_object). The fluid within kFluidClearance r0 of it is then
+// carved away as the scene builder does (a fluid layer that close to an Akinci layer starts 55%
+// over-dense). Returns the number of fluid particles carved.
+inline long add_box_solid(SimulationSetup& setup, Vec3d size, Vec3d centre, const SolidSetup& solid, Vec3 velocity,
+                          const std::function<bool(const Vec3&)>& pinned = nullptr) {
+    TriangleMesh box = make_box(size);
+    MeshTransform t;
+    t.translation = centre;
+    apply_transform(box, t);
+    const Real r0 = setup.params.fluid.spacing;
+    const std::size_t before = setup.position.size();
+    const auto object_id = static_cast<std::int32_t>(setup.solids.size());
+    add_solid_object(setup, box, solid, velocity, object_id, r0, setup.params.fluid.support_radius, pinned);
+    const std::vector<std::uint8_t> removed = carve_fluid(setup, Real(kFluidClearance) * r0, {}, before);
+    return std::count(removed.begin(), removed.end(), 1);
+}
+
+// Steps `sim` `steps` times and returns its particles.
+inline HostParticles run_steps(Simulation& sim, int steps) {
+    for (int s = 0; s < steps; ++s) sim.step();
+    HostParticles p;
+    sim.download(p);
+    return p;
+}
+
+// `setup` run for the same number of steps on OpenMP (at the current thread count), then on CUDA:
+// the particles and the last step's report of each. The caller checks cuda_backend_info().available
+// first, and skips with a "SKIPPED: " message where it is not.
+struct OpenmpAndCuda {
+    HostParticles openmp, cuda;
+    StepReport openmp_report, cuda_report;
+};
+inline OpenmpAndCuda run_openmp_and_cuda(const SimulationSetup& setup, int steps) {
+    OpenmpAndCuda out;
+    {
+        const std::unique_ptr<Simulation> cpu = create_openmp_simulation(setup, 0);
+        out.openmp = run_steps(*cpu, steps);
+        out.openmp_report = cpu->last_report();
+    }
+    const std::unique_ptr<Simulation> gpu = create_cuda_simulation(setup);
+    out.cuda = run_steps(*gpu, steps);
+    out.cuda_report = gpu->last_report();
+    return out;
+}
+
+// The largest distance |a.position[i] - b.position[i]| between two runs of the same setup, over the
+// particles whose type (in a) `include` accepts (all when it is empty).
+inline double largest_position_difference(const HostParticles& a, const HostParticles& b,
+                                          const std::function<bool(std::uint8_t)>& include = nullptr) {
+    double worst = 0;
+    for (std::size_t i = 0; i < a.position.size(); ++i)
+        if (!include || include(a.type[i])) worst = std::max(worst, double(norm(a.position[i] - b.position[i])));
+    return worst;
 }
 
 // The fluid particle mass the solver uses, ρ0 / Σ W over the lattice offsets within h = 2 r0

@@ -122,6 +122,10 @@ TEST_CASE("sphere of radius 10 r0: IBP volume, no IBP outside, coverage, normals
     const double per_r0_squared = double(s.sbp.count()) / (4 * M_PI * R * R / (r0 * r0));
     MESSAGE("sphere: " << per_r0_squared << " SBPs per r0^2");
     CHECK(per_r0_squared >= 1.54);
+    // The upper bound is a cost bound, not the packing limit (that one, 4.62 per r0², is the spacing
+    // check above): docs/sampling.md quotes about 2.6 SBPs per r0² and this sphere gives 2.51, so 3.0
+    // (20% over) fails a sampler that drifts toward denser packings, which would cost every step more
+    // boundary particles for no better coverage.
     CHECK(per_r0_squared <= 3.0);
     // Symmetric lattice: the centred lattice puts the sphere centre between points.
     CHECK(s.ibp.grid.origin.x() == doctest::Approx(-0.95));
