@@ -23,7 +23,10 @@ if [[ -n "${BENCH_BACKENDS:-}" ]] && want cuda && [[ -z "$gpu" ]]; then
   echo "bench: BENCH_BACKENDS=$BENCH_BACKENDS but no usable CUDA device in $build" >&2
   exit 3
 fi
+# A second report of the same day and device does not overwrite the first: -run2, -run3, ...
 out="bench/results/${date}-${device}.md"
+n=2
+while [[ -e $out ]]; do out="bench/results/${date}-${device}-run$((n++)).md"; done
 mkdir -p bench/results
 {
   echo "# Benchmarks, ${date}, ${device}"
