@@ -121,11 +121,14 @@ int command_run(int argc, char** argv) {
     std::unique_ptr<Simulation> sim;
     try {
         // stats.csv and summary.json are renamed into place at the end: a directory by those
-        // names would only fail then, after the whole run. (A file named frames fails at once,
-        // when the frame writer makes its directory.)
+        // names would only fail then, after the whole run. A file named frames would fail when the
+        // frame writer makes its directory, after the simulation (a GPU upload) is built.
         for (const std::string& path : {stats_path, summary_path})
             if (std::filesystem::is_directory(path))
                 throw InputError(path + " is a directory; the run writes a file there");
+        const std::string frames_path = out_dir + "/frames";
+        if (scene.writes_vtu() && std::filesystem::exists(frames_path) && !std::filesystem::is_directory(frames_path))
+            throw InputError(frames_path + " is a file; the run writes its frames in a directory there");
         sim = create_simulation(setup, backend, threads);
     } catch (...) {
         remove_created_directories(created);

@@ -154,7 +154,6 @@ T transform_reduce(const char* name, std::size_t n, T identity, Op op, F f) {
         check_cuda(cudaMemset(result.view().data(), 0, sizeof(T)), "reduction result");
         return result;
     }();
-    device_result.resize(1);
     thrust::counting_iterator<std::size_t> first(0);
     IndexTransform<T, F> transform{f};
     std::size_t temp_bytes = 0;

@@ -127,6 +127,12 @@ TEST_CASE("bad input: a failed run leaves no directory it made, and no run write
     fs::create_directories(taken + "/summary.json");
     check_rejected(run("run " + tiny() + " --steps 1 --out " + taken), {"summary.json", "is a directory"});
     CHECK(!fs::exists(taken + "/stats.csv"));
+    // A file named frames is found before the simulation is built, too.
+    const std::string framed = out_dir("framed");
+    fs::create_directories(framed);
+    std::ofstream(framed + "/frames") << "not a directory\n";
+    check_rejected(run("run " + tiny() + " --steps 1 --out " + framed), {"frames", "is a file"});
+    CHECK(!fs::exists(framed + "/stats.csv"));
     // Text that is not UTF-8 (JSON files are checked by the parser; a --set value that is not JSON
     // is taken as a plain string) fails at once, not after the run when summary.json is written.
     check_rejected(run("run " + tiny() + " --steps 1 --out " + out_dir("latin1") + " --set 'description=caf\xe9'"),

@@ -88,7 +88,9 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
     for (std::size_t i = 0; i < p.position.size(); ++i)
         if (p.type[i] == kFluid) top = std::max(top, double(p.position[i].y));
     const double H = top + r0 / 2, rho_g = 1000.0 * 9.81, margin = 2 * 2 * r0;
-    CHECK(H == doctest::Approx(height).epsilon(0.03));  // the column neither collapsed nor rose
+    // The column neither collapsed nor rose: 3% relative (scale 0; measured 1.8% lower, the
+    // compression that holds it up).
+    CHECK(H == doctest::Approx(height).epsilon(0.03).scale(0));
 
     const test::HydrostaticProfile profile =
         test::hydrostatic_profile(p, smoothed_sum, averaged, rho_g, 0, H, r0, Vec3{margin, margin, margin},

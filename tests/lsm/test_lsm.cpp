@@ -504,7 +504,7 @@ TEST_CASE("wall contact: IBPs clamped to the margin r0/2, outward velocity dropp
     CHECK(worst_position < 1e-7);
 }
 
-TEST_CASE("dropped on the floor: the lowest IBPs rest at domain_min.y + r0/2 with zero vertical velocity; friction stops the slide") {
+TEST_CASE("dropped on the floor: the lowest IBPs rest at domain_min.y + r0/2 with zero vertical velocity, and friction stops the slide") {
     // A box dropped flat from 6 cm, sliding at 0.3 m/s; rigid, and elastic with damping. After
     // 1.2 s every step of the next 0.3 s is checked.
     const Real dt = Real(0.005), r0 = Real(0.02), friction = Real(0.2);
