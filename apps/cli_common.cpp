@@ -1,5 +1,7 @@
 #include "apps/cli_common.hpp"
 
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -24,16 +26,11 @@ std::string quoted_token(const std::string& message) {
     return message;
 }
 
-// Which option on the command line was given `value` ("--steps abc", "--steps=abc" or "-s abc"),
-// so that a value that fails to parse is reported with its option's name.
-std::string option_given_value(const std::vector<char*>& args, const std::string& value) {
-    for (std::size_t i = 1; i < args.size(); ++i) {
-        const std::string a = args[i];
-        const std::size_t eq = a.find('=');
-        if (a.rfind("--", 0) == 0 && eq != std::string::npos && a.substr(eq + 1) == value) return a.substr(0, eq);
-        if (a == value && a.rfind("-", 0) != 0 && std::string(args[i - 1]).rfind("-", 0) == 0) return args[i - 1];
-    }
-    return "an option";
+// Whether a token reads as an option rather than a value: "--quiet", "-q". Negative numbers
+// ("-5", "-1,0,0" for --translate) are values.
+bool looks_like_option(const std::string& token) {
+    return token.rfind("--", 0) == 0 ||
+           (token.size() >= 2 && token[0] == '-' && std::isalpha(static_cast<unsigned char>(token[1])));
 }
 }  // namespace
 
@@ -41,7 +38,7 @@ void add_scene_options(cxxopts::Options& options) {
     options.add_options()
         ("scene", "scene file (JSON); the built-in 3D dam break when omitted", cxxopts::value<std::string>())
         ("set", "override a scene key, e.g. --set solver.dt=0.002 or --set gravity=[0,-1,0] (repeatable)",
-         cxxopts::value<std::string>())
+         cxxopts::value<std::string>(), "K=V")
         ("h,help", "show this help");
     options.parse_positional({"scene"});
     options.positional_help("[SCENE]");
@@ -63,6 +60,12 @@ cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** a
     }
     try {
         cxxopts::ParseResult result = options.parse(static_cast<int>(rest.size()), rest.data());
+        // cxxopts gives an option that takes a value the next token whatever it is: `--steps
+        // --quiet` would make "--quiet" the step count, `--out -q` a directory named "-q".
+        for (const cxxopts::KeyValue& given : result.arguments())
+            if (looks_like_option(given.value()))
+                throw InputError("--" + given.key() + " needs a value, but is followed by the option '" +
+                                 given.value() + "'");
         if (!result.unmatched().empty()) {
             const std::string hint = overrides ? " (one scene at most)" : "";
             throw InputError("unexpected argument '" + result.unmatched().front() + "'" + hint);
@@ -77,9 +80,17 @@ cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** a
                                      "', then '" + given[a].value() + "'); give it once");
         return result;
     } catch (const cxxopts::exceptions::incorrect_argument_type& e) {
+        // Only flags are typed for cxxopts (every other value is a string, converted by
+        // integer_option and number_option), and a flag takes a value only as `--flag=value`.
         const std::string value = quoted_token(e.what());
-        throw InputError(option_given_value(rest, value) + ": '" + value + "' is not a valid value" +
-                         " (see '" + options.program() + " --help')");
+        std::string flag = "a flag";
+        for (const char* a : rest) {
+            const std::string given = a;
+            const std::size_t eq = given.find('=');
+            if (given.rfind("--", 0) == 0 && eq != std::string::npos && given.substr(eq + 1) == value)
+                flag = given.substr(0, eq);
+        }
+        throw InputError(flag + ": '" + value + "' is not true or false");
     } catch (const cxxopts::exceptions::missing_argument& e) {
         throw InputError("--" + quoted_token(e.what()) + " needs a value");
     } catch (const cxxopts::exceptions::no_such_option& e) {
@@ -178,13 +189,39 @@ void check_host_memory(const Scene& scene, const std::string& backend, bool host
                           format_bytes(available) + " is available; increase fluid.spacing or shrink the scene");
 }
 
+long integer_option(const cxxopts::ParseResult& args, const std::string& name, long fallback) {
+    if (!args.count(name)) return fallback;
+    const std::string text = args[name].as<std::string>();
+    long value = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error == std::errc::result_out_of_range)
+        throw InputError("--" + name + ": '" + text + "' is out of range");
+    if (error != std::errc() || end != text.data() + text.size() || text.empty())
+        throw InputError("--" + name + ": expected a whole number, got '" + text + "'");
+    return value;
+}
+
+double number_option(const cxxopts::ParseResult& args, const std::string& name, double fallback) {
+    if (!args.count(name)) return fallback;
+    const std::string text = args[name].as<std::string>();
+    double value = 0;
+    // from_chars reads no leading '+', no whitespace and no locale: "2.5" means 2.5 everywhere.
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error == std::errc::result_out_of_range)
+        throw InputError("--" + name + ": '" + text + "' is out of range");
+    if (error != std::errc() || end != text.data() + text.size() || text.empty())
+        throw InputError("--" + name + ": expected a number, got '" + text + "'");
+    if (!std::isfinite(value)) throw InputError("--" + name + ": expected a finite number, got '" + text + "'");
+    return value;
+}
+
 int threads_option(const cxxopts::ParseResult& args) {
     if (!args.count("threads")) return 0;
-    constexpr int kMaxThreads = 1024;
-    const int threads = args["threads"].as<int>();
+    constexpr long kMaxThreads = 1024;
+    const long threads = integer_option(args, "threads", 0);
     if (threads < 1 || threads > kMaxThreads)
         throw InputError("--threads must be in [1, " + std::to_string(kMaxThreads) + "], got " + std::to_string(threads));
-    return threads;
+    return static_cast<int>(threads);
 }
 
 std::string format_number(double v) {

@@ -16,6 +16,7 @@ namespace mw {
 void add_scene_options(cxxopts::Options& options);
 
 // Parses, converting every cxxopts complaint (unknown option, missing or bad value) to InputError.
+// An option followed by another option instead of its value (`--steps --quiet`) is refused.
 // `--set K=V` / `--set=K=V` are taken out first and kept in order in `overrides` (cxxopts would
 // split their values at commas, breaking `--set gravity=[0,-1,0]`).
 cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** argv,
@@ -45,6 +46,13 @@ std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, cons
 // the simulation runs on the host (openmp, or `info` measuring a layout there) rather than on a
 // GPU, where the host keeps only the initial particles and frame buffers.
 void check_host_memory(const Scene& scene, const std::string& backend, bool host_layout);
+
+// Numeric options are declared as strings (cxxopts::value<std::string>()) and converted here, so
+// that a bad value is reported by its option's name in this program's words; cxxopts' own
+// conversion errors name only the value. Each returns `fallback` when the option is absent and
+// throws InputError for text that is not entirely a number (or is out of range, or not finite).
+long integer_option(const cxxopts::ParseResult& args, const std::string& name, long fallback);
+double number_option(const cxxopts::ParseResult& args, const std::string& name, double fallback);
 
 // The --threads option: 0 when absent, else a count in [1, 1024] (InputError otherwise). Each
 // OpenMP thread reserves a stack, and libgomp crashes when it cannot create tens of thousands.

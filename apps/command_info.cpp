@@ -18,7 +18,7 @@ int command_info(int argc, char** argv) {
     add_scene_options(options);
     options.add_options()("json", "print one JSON object instead of text")(
         "backend", "the backend whose memory layout to estimate: auto (what run would use), cuda or openmp",
-        cxxopts::value<std::string>()->default_value("auto"));
+        cxxopts::value<std::string>()->default_value("auto"), "NAME");
     std::vector<std::string> overrides;
     const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
     if (flag_option(args, "help")) {

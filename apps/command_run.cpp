@@ -72,11 +72,11 @@ int command_run(int argc, char** argv) {
                              "frames/particles_NNNNN.vtu, stats.csv and summary.json into the output directory.");
     add_scene_options(options);
     options.add_options()
-        ("backend", "auto, cuda or openmp", cxxopts::value<std::string>()->default_value("auto"))
-        ("out", "output directory (default results/<scene name>)", cxxopts::value<std::string>())
-        ("steps", "run exactly N steps", cxxopts::value<long>())
-        ("time", "run to simulated time T seconds (default: the scene's run.end_time)", cxxopts::value<double>())
-        ("threads", "OpenMP threads (default: all cores)", cxxopts::value<int>())
+        ("backend", "auto, cuda or openmp", cxxopts::value<std::string>()->default_value("auto"), "NAME")
+        ("out", "output directory (default results/<scene name>)", cxxopts::value<std::string>(), "DIR")
+        ("steps", "run exactly N steps", cxxopts::value<std::string>(), "N")
+        ("time", "run to simulated time T seconds (default: the scene's run.end_time)", cxxopts::value<std::string>(), "T")
+        ("threads", "OpenMP threads, 1 to 1024 (default: all cores)", cxxopts::value<std::string>(), "N")
         ("q,quiet", "print only the final summary line and errors");
     std::vector<std::string> overrides;
     const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
@@ -85,23 +85,18 @@ int command_run(int argc, char** argv) {
         return 0;
     }
     if (args.count("steps") && args.count("time")) throw InputError("--steps and --time exclude each other; give one");
-    long end_steps = 0;
-    if (args.count("steps")) {
-        end_steps = args["steps"].as<long>();
-        if (end_steps < 1) throw InputError("--steps must be at least 1, got " + std::to_string(end_steps));
-    }
+    const long end_steps = integer_option(args, "steps", 0);
+    if (args.count("steps") && end_steps < 1)
+        throw InputError("--steps must be at least 1, got " + std::to_string(end_steps));
     const int threads = threads_option(args);
     const bool quiet = flag_option(args, "quiet");
     const StopSignals stop_signals;
 
     Scene scene = scene_from_options(args, overrides);
-    double end_time = scene.end_time;
-    if (args.count("time")) {
-        end_time = args["time"].as<double>();
-        // The same bound as run.end_time: 1e300 s would run for ever.
-        if (!(end_time > 0) || !(end_time <= 1e6))
-            throw InputError("--time must be in (0, 1e6] seconds, got " + format_number(end_time));
-    }
+    const double end_time = number_option(args, "time", scene.end_time);
+    // The same bound as run.end_time: 1e300 s would run for ever.
+    if (args.count("time") && !(end_time > 0 && end_time <= 1e6))
+        throw InputError("--time must be in (0, 1e6] seconds, got " + format_number(end_time));
     const std::string backend = choose_backend(args["backend"].as<std::string>());
     if (threads > 0 && backend != "openmp" && !quiet)
         std::fprintf(stderr, "meltwater: note: --threads applies to the openmp backend only\n");
@@ -112,7 +107,8 @@ int command_run(int argc, char** argv) {
     check_host_memory(scene, backend, backend == "openmp");
     // --threads bounds the set-up too: objects are sampled on the host's OpenMP threads.
     if (backend == "openmp") set_host_threads(threads);
-    const SimulationSetup setup = build_setup(scene);
+    long carved_fluid = 0;
+    const SimulationSetup setup = build_setup(scene, &carved_fluid);
     if (g_interrupted) return report_interrupted_setup();
     // Before the simulation is built, so that an unwritable --out fails at once; the directories
     // made here are removed again (if still empty) when the run ends before its first step.
@@ -152,6 +148,7 @@ int command_run(int argc, char** argv) {
     summary.device = sim->device_name();
     summary.threads = threads;
     summary.particles = sim->counts();
+    summary.fluid_carved = carved_fluid;
     summary.device_bytes = sim->device_bytes();
     char stop[64];
     if (end_steps > 0) std::snprintf(stop, sizeof stop, "steps %ld", end_steps);
@@ -160,10 +157,13 @@ int command_run(int argc, char** argv) {
 
     if (!quiet) {
         const ParticleCounts& c = summary.particles;
-        std::fprintf(stderr, "meltwater: %s (%s): %s particles (%s fluid, %s boundary) on %s [%s], %s; output in %s\n",
+        // Carving changes how much fluid a scene holds: say so where the counts are given.
+        const std::string carved =
+            carved_fluid > 0 ? "; " + with_thousands(carved_fluid) + " fluid carved out where solids stand" : "";
+        std::fprintf(stderr, "meltwater: %s (%s): %s particles (%s fluid, %s boundary%s) on %s [%s], %s; output in %s\n",
                      scene.name.empty() ? "scene" : scene.name.c_str(), scene.source.c_str(),
                      with_thousands(c.total()).c_str(), with_thousands(c.by_type[kFluid]).c_str(),
-                     with_thousands(c.total() - c.by_type[kFluid]).c_str(), summary.backend.c_str(),
+                     with_thousands(c.total() - c.by_type[kFluid]).c_str(), carved.c_str(), summary.backend.c_str(),
                      summary.device.c_str(), stop, out_dir.c_str());
     }
 

@@ -96,15 +96,15 @@ int command_sample(int argc, char** argv) {
                              "stairs, e.g. \"sphere:radius=0.5,subdivisions=5\" or \"hollow_box:x=1,y=1,z=1,wall=0.1\".");
     options.add_options()
         ("mesh", "OBJ file or procedural mesh spec", cxxopts::value<std::string>())
-        ("spacing", "particle spacing r0 (m), required", cxxopts::value<double>())
-        ("out", "output directory for sbp.vtu, ibp.vtu, gp.vtu, required", cxxopts::value<std::string>())
-        ("support", "kernel support radius h for the GP links (default 2.5 r0)", cxxopts::value<double>())
-        ("scale", "scale, one factor or x,y,z (applied first)", cxxopts::value<std::string>())
-        ("rotate", "rotation, Euler angles in degrees about x, y, z (applied in that order)", cxxopts::value<std::string>())
-        ("translate", "translation x,y,z (applied last)", cxxopts::value<std::string>())
+        ("spacing", "particle spacing r0 (m), required", cxxopts::value<std::string>(), "R")
+        ("out", "output directory for sbp.vtu, ibp.vtu, gp.vtu, required", cxxopts::value<std::string>(), "DIR")
+        ("support", "kernel support radius h for the GP links (default 2.5 r0)", cxxopts::value<std::string>(), "H")
+        ("scale", "scale, one factor or x,y,z (applied first)", cxxopts::value<std::string>(), "S|X,Y,Z")
+        ("rotate", "rotation, Euler angles in degrees about x, y, z (applied in that order)", cxxopts::value<std::string>(), "X,Y,Z")
+        ("translate", "translation x,y,z (applied last)", cxxopts::value<std::string>(), "X,Y,Z")
         ("directions", "ray line families for inside/outside: 0 auto (3 closed, 13 open), 3, 7 or 13",
-         cxxopts::value<int>()->default_value("0"))
-        ("threads", "OpenMP threads, 1 to 1024 (default: OpenMP's, e.g. OMP_NUM_THREADS)", cxxopts::value<int>())
+         cxxopts::value<std::string>(), "N")
+        ("threads", "OpenMP threads, 1 to 1024 (default: OpenMP's, e.g. OMP_NUM_THREADS)", cxxopts::value<std::string>(), "N")
         ("no-coverage", "skip the coverage check")
         ("h,help", "show this help");
     options.parse_positional({"mesh"});
@@ -118,14 +118,14 @@ int command_sample(int argc, char** argv) {
     if (!args.count("spacing")) throw InputError("sample: missing --spacing R (the particle spacing r0 in metres)");
     if (!args.count("out")) throw InputError("sample: missing --out DIR");
     const std::string mesh_arg = args["mesh"].as<std::string>();
-    const double r0 = args["spacing"].as<double>();
+    const double r0 = number_option(args, "spacing", 0);
     if (!std::isfinite(r0) || r0 <= 0) throw InputError("--spacing must be a positive number");
-    const double h = args.count("support") ? args["support"].as<double>() : 2.5 * r0;
+    const double h = number_option(args, "support", 2.5 * r0);
     // The same range as a scene's fluid.support_radius: a huge h links every GP to every IBP.
     if (!std::isfinite(h) || !(h > r0) || h > 4 * r0)
         throw InputError("--support must be in (spacing, 4 x spacing], got " + format_number(h) + " with spacing " +
                          format_number(r0));
-    const int directions = args["directions"].as<int>();
+    const long directions = integer_option(args, "directions", 0);
     if (directions != 0 && directions != 3 && directions != 7 && directions != 13)
         throw InputError("--directions must be 0, 3, 7 or 13");
     // Before the output directory is made: see set_host_threads.

@@ -196,6 +196,7 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     for (int t = 0; t < kParticleTypeCount; ++t) particles[particle_type_name(t)] = run.particles.by_type[t];
     particles["total"] = run.particles.total();
     j["particles"] = particles;
+    j["fluid_carved"] = run.fluid_carved;
     j["lost_particles"] = run.lost_particles;
     SceneJson ms;
     const std::vector<double> medians = stats.median_stage_ms();

@@ -80,6 +80,7 @@ struct RunSummary {
     double wall_seconds = 0;
     long lost_particles = 0;
     ParticleCounts particles;
+    long fluid_carved = 0;  // fluid particles left out where static boxes and objects stand
     std::size_t device_bytes = 0;
     int frames = 0;
     std::string stop_condition;  // "steps N" or "time T s"

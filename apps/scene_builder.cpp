@@ -8,7 +8,6 @@
 #include "backend/errors.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/inside_outside.hpp"
-#include "sampling/kdtree.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/solid_sample.hpp"
@@ -40,8 +39,7 @@ void append(SimulationSetup& s, const std::vector<Vec3>& points, Vec3 velocity, 
 // object's extent is known only once its mesh is loaded and transformed. Outside the domain its
 // particles would be clamped onto the walls in the first step. A mesh touching a face may
 // overshoot it by rounding (OBJ coordinates are read as float): a thousandth of r0 is allowed.
-void check_object_inside_domain(const Scene& scene, const TriangleMesh& mesh) {
-    const Aabb box = bounding_box(mesh);
+void check_object_inside_domain(const Scene& scene, const Aabb& box) {
     const double slack = 1e-3 * scene.params.fluid.spacing;
     const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
     if (box.lo.x() < lo.x - slack || box.lo.y() < lo.y - slack || box.lo.z() < lo.z - slack ||
@@ -97,22 +95,37 @@ void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& pl
                                  " inner particles lie inside the box; objects do not collide with static boxes, so "
                                  "move it out (touching is fine)");
         }
-        for (std::size_t j = 0; j < placed.size(); ++j) {
-            const PlacedObject& b = placed[j];
-            if (j == k || (!a.moves && !b.moves) || !a.bounds.intersects(b.bounds)) continue;
-            std::vector<Vec3d> candidates;
+    }
+    // inside_count[k][j]: how many of object k's inner particles lie inside object j's mesh. Each
+    // mesh is classified once, against the candidates of every object that may overlap it (the
+    // ray tracer's scene is built per call).
+    const std::size_t n = placed.size();
+    std::vector<std::vector<long>> inside_count(n, std::vector<long>(n, 0));
+    for (std::size_t j = 0; j < n; ++j) {
+        const PlacedObject& b = placed[j];
+        std::vector<Vec3d> candidates;
+        std::vector<std::size_t> owner;  // which object each candidate belongs to
+        for (std::size_t k = 0; k < n; ++k) {
+            const PlacedObject& a = placed[k];
+            if (k == j || (!a.moves && !b.moves) || !a.bounds.intersects(b.bounds)) continue;
             for (const Vec3d& x : a.inner)
-                if (b.bounds.contains(x)) candidates.push_back(x);
-            if (candidates.empty()) continue;
-            const std::vector<std::uint8_t> inside = classify_points(b.mesh, candidates);
-            const long count = std::count(inside.begin(), inside.end(), std::uint8_t(1));
-            if (count > 0)
+                if (b.bounds.contains(x)) {
+                    candidates.push_back(x);
+                    owner.push_back(k);
+                }
+        }
+        if (candidates.empty()) continue;
+        const std::vector<std::uint8_t> inside = classify_points(b.mesh, candidates);
+        for (std::size_t c = 0; c < candidates.size(); ++c) inside_count[owner[c]][j] += inside[c];
+    }
+    // The first overlapping pair in scene order is reported.
+    for (std::size_t k = 0; k < n; ++k)
+        for (std::size_t j = 0; j < n; ++j)
+            if (inside_count[k][j] > 0)
                 throw InputError(scene.source + ": " + describe(k) + " overlaps " + describe(j) + ": " +
-                                 std::to_string(count) + " of its " + std::to_string(a.inner.size()) +
+                                 std::to_string(inside_count[k][j]) + " of its " + std::to_string(placed[k].inner.size()) +
                                  " inner particles lie inside the other's mesh; objects do not collide with one "
                                  "another, so move them apart (touching is fine)");
-        }
-    }
 }
 
 }  // namespace
@@ -167,7 +180,11 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }
     // Every object's mesh and inner particles, kept where there is something for it to overlap.
-    const bool check_overlaps = scene.objects.size() > 1 || (!scene.objects.empty() && !scene.static_boxes.empty());
+    // Static solids may overlap one another, so without a moving object there is nothing to check.
+    const bool any_moving = std::any_of(scene.objects.begin(), scene.objects.end(),
+                                        [](const SceneObject& o) { return o.kind != SolidKind::kStatic; });
+    const bool check_overlaps =
+        any_moving && (scene.objects.size() > 1 || (!scene.objects.empty() && !scene.static_boxes.empty()));
     std::vector<PlacedObject> placed;
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
         const SceneObject& o = scene.objects[k];
@@ -194,7 +211,9 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             PlacedObject object;
             object.mesh = object_mesh(scene, o);
             object.moves = o.kind != SolidKind::kStatic;
-            check_object_inside_domain(scene, object.mesh);
+            const Aabb box = bounding_box(object.mesh);
+            object.bounds = Eigen::AlignedBox3d(box.lo, box.hi);
+            check_object_inside_domain(scene, box);
             check_object_particle_budget(scene, object.mesh, setup.position.size());
             const std::size_t first = setup.position.size();
             const std::size_t inner = add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
@@ -203,8 +222,6 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                 const Vec3 x = setup.position[i];
                 object.inner.emplace_back(x.x, x.y, x.z);
             }
-            const Aabb box = bounding_box(object.mesh);
-            object.bounds = Eigen::AlignedBox3d(box.lo, box.hi);
             if (check_overlaps) placed.push_back(std::move(object));
         } catch (const InputError& e) {
             throw InputError(scene.source + ": objects[" + std::to_string(k) + "] (" + o.name + "): " + e.what());
@@ -234,31 +251,20 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
 std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
                                       const std::vector<Eigen::AlignedBox3d>& boxes, std::size_t first_solid) {
     const std::size_t n = setup.position.size();
-    const auto to_vec3d = [](Vec3 x) { return Vec3d(x.x, x.y, x.z); };
-    std::vector<Vec3d> solid_points;
-    Eigen::AlignedBox3d reach;  // where carving can happen at all (empty to start with)
-    for (std::size_t i = first_solid; i < n; ++i) {
-        const std::uint8_t t = setup.type[i];
-        if (t != kStaticBoundary && t != kSurfaceBoundary && t != kInnerBoundary) continue;
-        solid_points.push_back(to_vec3d(setup.position[i]));
-        reach.extend(solid_points.back());
-    }
-    for (const Eigen::AlignedBox3d& box : boxes) reach.extend(box);
-    std::vector<std::uint8_t> removed(n, 0);
-    if (reach.isEmpty()) return removed;
-    reach.min().array() -= clearance;
-    reach.max().array() += clearance;
-    const PointTree tree(solid_points);
+    std::vector<Vec3> fluid, solid_points;
+    std::vector<std::size_t> fluid_index;
     for (std::size_t i = 0; i < n; ++i) {
-        const Vec3d x = to_vec3d(setup.position[i]);
-        if (setup.type[i] != kFluid || !reach.contains(x)) continue;
-        bool occupied = false;
-        for (const Eigen::AlignedBox3d& box : boxes) occupied = occupied || box.contains(x);
-        // A particle exactly `clearance` away stays, whichever way float rounding leans (a
-        // symmetric scene is carved symmetrically).
-        if (!occupied && !solid_points.empty()) occupied = tree.nearest(x).second < double(clearance) * (1 - 1e-4);
-        removed[i] = occupied;
+        const std::uint8_t t = setup.type[i];
+        if (t == kFluid) {
+            fluid.push_back(setup.position[i]);
+            fluid_index.push_back(i);
+        } else if (i >= first_solid && (t == kStaticBoundary || t == kSurfaceBoundary || t == kInnerBoundary)) {
+            solid_points.push_back(setup.position[i]);
+        }
     }
+    const std::vector<std::uint8_t> occupied = points_solids_occupy(fluid, solid_points, boxes, clearance);
+    std::vector<std::uint8_t> removed(n, 0);
+    for (std::size_t f = 0; f < fluid.size(); ++f) removed[fluid_index[f]] = occupied[f];
     // Compact the lists and renumber the solids' references to them.
     std::vector<std::uint32_t> new_index(n);
     std::size_t kept = 0;

@@ -7,6 +7,7 @@
 
 #include "algorithms/simulation.hpp"
 #include "apps/scene.hpp"
+#include "sampling/fluid_clearance.hpp"
 #include "sampling/mesh.hpp"
 
 namespace mw {
@@ -27,15 +28,9 @@ long estimate_particle_count(const Scene& scene);
 // carve_fluid); `carved_fluid`, when given, receives how many fluid particles that removed.
 SimulationSetup build_setup(const Scene& scene, long* carved_fluid = nullptr);
 
-// Fluid particles closer than this many r0 to a particle of a static box or an object are removed
-// (carve_fluid). A fluid layer r0/2 from an Akinci layer starts 55% over-dense and PCISPH blows it
-// apart in the first step; at r0 it is 6% over-dense, which the first step corrects quietly
-// (docs/solver.md, "Where the walls go").
-constexpr double kFluidClearance = 1.0;
-
-// Removes the fluid particles that solids occupy: those inside one of `boxes` (static boxes are
-// sampled on their faces only, so a large one is hollow) and those closer than `clearance` to a
-// static, surface or inner boundary particle at index >= first_solid (the domain walls, placed
+// Removes the fluid particles that solids occupy (points_solids_occupy, with clearance
+// kFluidClearance r0 in scenes): those inside one of `boxes` and those closer than `clearance` to
+// a static, surface or inner boundary particle at index >= first_solid (the domain walls, placed
 // before first_solid, sit kWallGap r0 outside the domain and never come that close). Indices in
 // setup.solids are renumbered. Returns, for every particle before the call, whether it was removed.
 std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,

@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "tests/scratch_dir.hpp"
+
 namespace cli_test {
 
 struct Result {
@@ -17,23 +19,8 @@ struct Result {
     std::string out, err;
 };
 
-// A scratch directory for this test process, removed at exit (kept when MW_KEEP_TEST_FILES is set).
-inline std::string scratch_dir() {
-    struct Scratch {
-        std::string path;
-        Scratch() {
-            const auto d = std::filesystem::temp_directory_path() / ("meltwater_cli_test_" + std::to_string(::getpid()));
-            std::filesystem::create_directories(d);
-            path = d.string();
-        }
-        ~Scratch() {
-            std::error_code ignored;
-            if (!std::getenv("MW_KEEP_TEST_FILES")) std::filesystem::remove_all(path, ignored);
-        }
-    };
-    static const Scratch scratch;
-    return scratch.path;
-}
+// This program's scratch directory (tests/scratch_dir.hpp).
+inline std::string scratch_dir() { return mw_test::scratch_dir("meltwater_cli_test").string(); }
 
 inline std::string slurp(const std::string& path) {
     std::ifstream in(path, std::ios::binary);

@@ -11,6 +11,7 @@
 #include "backend/config.hpp"
 #include "cli_helpers.hpp"
 #include "sampling/obj_loader.hpp"
+#include "tests/skip.hpp"
 
 using namespace cli_test;
 namespace fs = std::filesystem;
@@ -84,11 +85,20 @@ TEST_CASE("bad input: command line") {
     check_rejected(run("run " + tiny() + " --steps 2 --time 0.1"), {"--steps", "--time"});
     check_rejected(run("run " + tiny() + " --steps 0"), {"--steps"});
     // A value that does not parse is reported with the option it was given to, in every spelling.
-    check_rejected(run("run " + tiny() + " --steps many"), {"--steps", "'many'"});
-    check_rejected(run("run " + tiny() + " --threads=2.5"), {"--threads", "'2.5'"});
+    check_rejected(run("run " + tiny() + " --steps many"), {"--steps", "whole number", "'many'"});
+    check_rejected(run("run " + tiny() + " --threads=2.5"), {"--threads", "whole number", "'2.5'"});
+    check_rejected(run("run " + tiny() + " --steps 99999999999999999999"), {"--steps", "out of range"});
+    check_rejected(run("run " + tiny() + " --time 1e999"), {"--time", "out of range"});
+    check_rejected(run("run " + tiny() + " --time nan"), {"--time", "finite", "'nan'"});
+    check_rejected(run("run " + tiny() + " --time 1s"), {"--time", "'1s'"});
     check_rejected(run("run " + tiny() + " --quiet=maybe"), {"--quiet", "'maybe'"});
     check_rejected(run("run " + tiny() + " --steps"), {"--steps", "needs a value"});
-    check_rejected(run("sample x --spacing abc"), {"--spacing", "'abc'"});
+    // An option where a value should be is not taken as the value (cxxopts would take it).
+    check_rejected(run("run " + tiny() + " --steps --quiet"), {"--steps", "needs a value", "'--quiet'"});
+    check_rejected(run("run " + tiny() + " --steps 1 --out -q"), {"--out", "needs a value", "'-q'"});
+    check_rejected(run("sample x --spacing abc --out " + scratch_dir() + "/never"), {"--spacing", "'abc'"});
+    check_rejected(run("sample x --spacing 0.1 --directions three --out " + scratch_dir() + "/never"),
+                   {"--directions", "'three'"});
     check_rejected(run("run " + tiny() + " --time -1"), {"--time"});
     check_rejected(run("run " + tiny() + " --threads 0"), {"--threads"});
     check_rejected(run("run " + tiny() + " --backend vulkan"), {"--backend", "vulkan"});
@@ -150,7 +160,7 @@ TEST_CASE("bad input: a scene larger than the host's memory is refused before al
     while (std::getline(meminfo, line))
         if (std::sscanf(line.c_str(), "MemAvailable: %lf kB", &available_kib) == 1) break;
     if (available_kib == 0 || available_kib > 60e6) {
-        MESSAGE("SKIPPED: MemAvailable unknown or above 60 GB: the host-memory refusal is not tested here");
+        MW_SKIP("MemAvailable unknown or above 60 GB: the host-memory refusal is not tested here");
         return;
     }
     const std::string huge = "--set fluid.spacing=0.00036 --set 'fluid_blocks.0.max=[0.2,0.2,0.2]' --set fluid.support_radius=0.00072";
@@ -168,7 +178,7 @@ TEST_CASE("--backend cuda without a usable GPU is a clear error") {
     for (const auto& e : j["backends"])
         if (e["name"] == "cuda") cuda_available = e["available"].get<bool>();
     if (cuda_available) {
-        MESSAGE("SKIPPED: a GPU is available here; the no-GPU error is not tested");
+        MW_SKIP("a GPU is available here; the no-GPU error is not tested");
         return;
     }
     check_rejected(run("run " + tiny() + " --steps 1 --backend cuda --out " + out_dir("cuda")), {"cuda"}, 3);
@@ -263,6 +273,11 @@ TEST_CASE("bad input: a moving object that starts inside another object or a sta
                    {"objects[0]", "overlaps objects[1]", "4 of its 8 inner particles"});
     check_rejected(run("info " + scene("in_box", cube("elastic", 0.08), R"({"min": [0.075, 0.12, 0.12], "max": [0.2, 0.2, 0.2]})")),
                    {"objects[0]", "overlaps static_boxes[0]", "4 of its 8"});
+    // A static object with a moving one sunk into it, beside a third object apart from both: the
+    // pair is named, in scene order, whichever meshes were tested together.
+    check_rejected(run("info " + scene("three", cube("elastic", 0.02) + "," + cube("static", 0.08) + "," +
+                                                    cube("rigid", 0.1))),
+                   {"objects[1]", "overlaps objects[2]", "4 of its 8 inner particles"});
     // Touching is fine, and so are static solids sunk into one another (scenery).
     CHECK(run("info " + scene("touching", cube("elastic", 0.08) + "," + cube("elastic", 0.12))).code == 0);
     CHECK(run("info " + scene("static_pair", cube("static", 0.08) + "," + cube("static", 0.1),
@@ -292,11 +307,15 @@ TEST_CASE("a static box and an object inside the fluid carve it out, and the run
     // Uncarved, the fluid next to the solids started 55% over-dense and the first step blew it
     // apart; carved, it starts at rest.
     const std::string out = out_dir("carved_run");
-    const Result started = run("run " + folder + "/scene.json --steps 3 --threads 1 --quiet --out " + out);
+    const Result started = run("run " + folder + "/scene.json --steps 3 --threads 1 --out " + out);
     CAPTURE(started.err);
     REQUIRE(started.code == 0);
     const auto summary = read_json(out + "/summary.json");
     CHECK(summary["density_error"]["max"].get<double>() < 0.03);
+    // run reports the carving too: on its first line and in summary.json.
+    CHECK(contains(started.err, "(74 fluid, "));
+    CHECK(contains(started.err, "; 51 fluid carved out where solids stand)"));
+    CHECK(summary["fluid_carved"].get<long>() == 51);
 }
 
 TEST_CASE("the cantilever scene: its mesh is written per frame, and the pin holds the left end") {
@@ -449,7 +468,7 @@ TEST_CASE("a frame reads back with meshio") {
         if (python.empty() && std::system((std::string(candidate) + " -c 'import meshio' >/dev/null 2>&1").c_str()) == 0)
             python = candidate;
     if (python.empty()) {
-        MESSAGE("SKIPPED: python3 or meshio is missing (apt install python3-meshio)");
+        MW_SKIP("python3 or meshio is missing (apt install python3-meshio)");
         return;
     }
     const std::string dir = out_dir("meshio");
@@ -482,7 +501,7 @@ TEST_CASE("guards: a blow-up stops the run naming the step, keeping frame 0 and 
     // was found that overflows double within a few steps (PCISPH is invariant to the scale of the
     // density), so a double-precision build skips this case; the guard itself is the same code.
     if (sizeof(mw::Real) != 4) {
-        MESSAGE("SKIPPED: in a double-precision build no scene value blows it up within 5 steps");
+        MW_SKIP("in a double-precision build no scene value blows it up within 5 steps");
         return;
     }
     const Result r = run("run " + tiny() + " --steps 5 --out " + dir + " --set fluid.rest_density=1e38");

@@ -1,6 +1,6 @@
 // The scene parser in-process: defaults, resolution, overrides and every kind of bad input.
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
-#include <doctest/doctest.h>
+#define DOCTEST_CONFIG_IMPLEMENT
+#include "tests/skip.hpp"
 
 #include <filesystem>
 
@@ -302,3 +302,5 @@ TEST_CASE("the setup has fluid first, walls and static boxes with their object i
     const Scene open = parse_scene_text(tiny_scene_text(), "t", {"boundary.walls=false"});
     CHECK(count_particles(build_setup(open)).by_type[kStaticBoundary] == 0);
 }
+
+MW_TEST_MAIN

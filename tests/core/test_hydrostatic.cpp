@@ -11,8 +11,6 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <vector>
 
 #include "algorithms/sph_kernels.hpp"
@@ -50,28 +48,25 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
     const CubicSpline3D kernel = CubicSpline3D::with_support(2 * r0);
     const double rest_density = setup.params.fluid.rest_density;
     const double mass = test::lattice_mass(kernel, r0, rest_density);
-    double worst_avg_error = 0, worst_recomputed = 0;
+    double worst_recomputed = 0;
     int most_iterations = 0, diverged_steps = 0;
-    std::vector<double> smoothed_sum;
     std::vector<Vec3> fluid, walls;
-    HostParticles p;
-    for (int step = 0; step < steps; ++step) {
-        sim->step();
-        most_iterations = std::max(most_iterations, sim->last_report().iterations);
-        diverged_steps += sim->last_report().diverged;  // a diverged step also stops early
-        if (step < steps - averaged) continue;
-        worst_avg_error = std::max(worst_avg_error, sim->last_report().density_error_avg);
-        sim->download(p);
-        fluid.clear();
-        walls.clear();
-        for (std::size_t i = 0; i < p.position.size(); ++i) {
-            if (p.type[i] == kFluid) fluid.push_back(p.position[i]);
-            if (p.type[i] == kStaticBoundary) walls.push_back(p.position[i]);
-        }
-        worst_recomputed =
-            std::max(worst_recomputed, recomputed_mean_compression(fluid, walls, kernel, mass, rest_density));
-        test::add_smoothed_pressure(p, kernel, smoothed_sum);
-    }
+    const test::SettledColumn column = test::settle_column(
+        *sim, setup.params, steps, averaged, 0, width, 0,
+        [&](int, const StepReport& report, const HostParticles* p) {
+            most_iterations = std::max(most_iterations, report.iterations);
+            diverged_steps += report.diverged;  // a diverged step also stops early
+            if (!p) return;                     // downloaded on the averaged steps only
+            fluid.clear();
+            walls.clear();
+            for (std::size_t i = 0; i < p->position.size(); ++i) {
+                if (p->type[i] == kFluid) fluid.push_back(p->position[i]);
+                if (p->type[i] == kStaticBoundary) walls.push_back(p->position[i]);
+            }
+            worst_recomputed =
+                std::max(worst_recomputed, recomputed_mean_compression(fluid, walls, kernel, mass, rest_density));
+        });
+    const double worst_avg_error = column.worst_avg_error;
     // The stop rule was met on every step (a step that runs out of iterations ends with whatever
     // error it has), so the reported average error below means something.
     CHECK(most_iterations < setup.params.solver.max_iterations);
@@ -84,17 +79,12 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
     // to η (or a wrong mass or wall volume, which shift every density) fails. Measured: 0.80% both.
     CHECK(worst_recomputed < 1.5 * setup.params.solver.eta);
 
-    double top = 0;
-    for (std::size_t i = 0; i < p.position.size(); ++i)
-        if (p.type[i] == kFluid) top = std::max(top, double(p.position[i].y));
-    const double H = top + r0 / 2, rho_g = 1000.0 * 9.81, margin = 2 * 2 * r0;
+    const double H = column.H;
     // The column neither collapsed nor rose: 3% relative (scale 0; measured 1.8% lower, the
     // compression that holds it up).
     CHECK(H == doctest::Approx(height).epsilon(0.03).scale(0));
 
-    const test::HydrostaticProfile profile =
-        test::hydrostatic_profile(p, smoothed_sum, averaged, rho_g, 0, H, r0, Vec3{margin, margin, margin},
-                                  Vec3{width - margin, Real(H - margin), width - margin});
+    const test::HydrostaticProfile& profile = column.profile;
     REQUIRE(profile.layers >= 10);
     const double worst_layer = profile.worst_layer, worst_particle = profile.worst_particle;
     MESSAGE("settled H " << H << " m; worst layer deviation " << 100 * worst_layer

@@ -9,6 +9,7 @@
 #include "backend/backend.hpp"
 #include "backend/backend_registry.hpp"
 #include "test_setups.hpp"
+#include "tests/skip.hpp"
 
 using namespace mw;
 
@@ -27,12 +28,6 @@ bool bitwise_equal(const HostParticles& a, const HostParticles& b) {
            !std::memcmp(a.density.data(), b.density.data(), a.density.size() * sizeof(Real)) &&
            !std::memcmp(a.pressure.data(), b.pressure.data(), a.pressure.size() * sizeof(Real));
 }
-// create_openmp_simulation(setup, n) sets the thread count of the whole process (omp_set_num_threads)
-// and n = 0 keeps whatever it is, so a test that picks thread counts puts the previous one back.
-struct RestoreThreadCount {
-    const int saved = openmp_backend::thread_count();
-    ~RestoreThreadCount() { openmp_backend::set_threads(saved); }
-};
 }  // namespace
 
 TEST_CASE("two runs on the same backend are bitwise identical, whatever the thread count") {
@@ -47,7 +42,7 @@ TEST_CASE("two runs on the same backend are bitwise identical, whatever the thre
     REQUIRE(fluid > (1 << 14));
     REQUIRE(fluid % 2 != 0);
     REQUIRE(fluid % 3 != 0);
-    const RestoreThreadCount restore;
+    const test::RestoreThreadCount restore;
     const int steps = 20;
     auto run_on = [&](int threads) {
         auto sim = create_openmp_simulation(setup, threads);
@@ -72,7 +67,7 @@ TEST_CASE("two runs on the same backend are bitwise identical, whatever the thre
 // so two runs must agree bit for bit. 50 steps, as for the comparison with OpenMP below.
 TEST_CASE("CUDA against CUDA: two runs are bitwise identical (grid gathers and neighbour lists)") {
     if (!cuda_backend_info().available) {
-        MESSAGE("SKIPPED: " << cuda_backend_info().description);
+        MW_SKIP(cuda_backend_info().description);
         return;
     }
     for (const auto lists : {SimulationParams::Lists::kOff, SimulationParams::Lists::kOn}) {
@@ -91,7 +86,7 @@ TEST_CASE("CUDA against CUDA: two runs are bitwise identical (grid gathers and n
 namespace {
 void compare_cuda_with_openmp(SimulationParams::Lists lists) {
     if (!cuda_backend_info().available) {
-        MESSAGE("SKIPPED: " << cuda_backend_info().description);
+        MW_SKIP(cuda_backend_info().description);
         return;
     }
     SimulationSetup setup = small_dam_break();
@@ -198,24 +193,31 @@ std::vector<StepReport> cfl_steps(const SimulationSetup& setup, int steps) {
 }  // namespace
 
 namespace {
-constexpr double cfl_r0 = 0.4 * 0.02;  // free_block_cfl's cfl_number times r0
-// The CFL bound under gravity 9.81 m/s²: the Δt with (v + g Δt) Δt = cfl r0.
-double cfl_bound_under_gravity(double v) { return 2 * cfl_r0 / (v + std::sqrt(v * v + 4 * 9.81 * cfl_r0)); }
+// The distance a particle may move in a CFL step: the setup's cfl_number times its r0.
+double cfl_r0(const SimulationParams& params) { return double(params.solver.cfl_number) * double(params.fluid.spacing); }
+// The CFL bound under the setup's gravity g: the Δt with (v + g Δt) Δt = cfl r0.
+double cfl_bound_under_gravity(const SimulationParams& params, double v) {
+    const double g = -double(params.gravity.y);
+    return 2 * cfl_r0(params) / (v + std::sqrt(v * v + 4 * g * cfl_r0(params)));
+}
 }  // namespace
 
 TEST_CASE("CFL time steps follow the last step's largest speed and gravity, capped at dt and floored at dt_min") {
     // Without gravity Δt = cfl r0 / v_max.
-    // Float parameters (0.4f * 0.02f / v in float): agreement to a few float roundings.
+    // Float parameters (0.4f * 0.02f / v in float): agreement to a few float roundings, relative
+    // (scale 0: doctest's default scale of 1 would make this 1e-6 s, an eighth of the 8 ms step).
+    // Measured: at most 5.5e-8, half a float ulp.
     const double rounding = 1e-6;
 
     SUBCASE("a block moving at 1 m/s steps 0.4 r0 / (1 m/s) = 0.008 s") {
-        const std::vector<StepReport> r = cfl_steps(free_block_cfl({1, 0, 0}), 5);
+        const SimulationSetup setup = free_block_cfl({1, 0, 0});
+        const std::vector<StepReport> r = cfl_steps(setup, 5);
         // The first step uses the initial speeds, every later one the speed the step before reported.
-        CHECK(r[0].dt == doctest::Approx(cfl_r0 / 1.0).epsilon(rounding));
+        CHECK(r[0].dt == doctest::Approx(cfl_r0(setup.params) / 1.0).epsilon(rounding).scale(0));
         for (std::size_t k = 1; k < r.size(); ++k) {
             // A free block at rest density translates: no pressure, no viscosity, no gravity.
             CHECK(r[k - 1].max_speed == doctest::Approx(1.0).epsilon(1e-4));
-            CHECK(r[k].dt == doctest::Approx(cfl_r0 / r[k - 1].max_speed).epsilon(rounding));
+            CHECK(r[k].dt == doctest::Approx(cfl_r0(setup.params) / r[k - 1].max_speed).epsilon(rounding).scale(0));
         }
     }
     // Below, the step is one of the parameters itself, passed through: compared exactly.
@@ -238,7 +240,7 @@ TEST_CASE("CFL time steps follow the last step's largest speed and gravity, capp
         SimulationSetup setup = free_block_cfl({0, 0, 0}, {0, -9.81f, 0});
         setup.params.solver.dt = 0.05f;
         const std::vector<StepReport> r = cfl_steps(setup, 1);
-        CHECK(r[0].dt == doctest::Approx(std::sqrt(cfl_r0 / 9.81)).epsilon(rounding));
+        CHECK(r[0].dt == doctest::Approx(std::sqrt(cfl_r0(setup.params) / 9.81)).epsilon(rounding).scale(0));
         CHECK(r[0].dt < 0.05);
     }
     SUBCASE("each step uses the speed reached by the step before (free fall of a lone particle)") {
@@ -256,12 +258,14 @@ TEST_CASE("CFL time steps follow the last step's largest speed and gravity, capp
         double v = 0;
         int cfl_limited = 0;
         for (const StepReport& report : r) {
-            const double dt = std::min(0.01, std::max(1e-6, cfl_bound_under_gravity(v)));
+            const double dt = std::min(0.01, std::max(1e-6, cfl_bound_under_gravity(setup.params, v)));
             cfl_limited += dt < 0.01;
             v += 9.81 * dt;
-            // Float velocities summed over 30 steps: relative rounding of order 30 x 6e-8.
-            CHECK(report.dt == doctest::Approx(dt).epsilon(1e-5));
-            CHECK(report.max_speed == doctest::Approx(v).epsilon(1e-5));
+            // Float velocities summed over 30 steps: relative rounding of order 30 x 6e-8 (scale 0,
+            // relative: the default scale of 1 would allow 1e-5 s on steps of 3 to 10 ms). Measured:
+            // at most 1.2e-7 on the step, 1.0e-7 on the speed.
+            CHECK(report.dt == doctest::Approx(dt).epsilon(1e-5).scale(0));
+            CHECK(report.max_speed == doctest::Approx(v).epsilon(1e-5).scale(0));
         }
         CHECK(cfl_limited >= 15);  // most of the run tests the CFL branch, not the cap
     }
@@ -296,7 +300,7 @@ TEST_CASE("CFL retries: the largest step grows back by at most a quarter, by les
         // and 1.125 for the 20 steps after a retry that came within 20 steps of the one before.
         if (k == 0) continue;
         const double v_before = k >= 2 ? r[k - 2].max_speed : 0.0;
-        if (r[k - 1].dt > cfl_bound_under_gravity(v_before) * (1 - 1e-5)) continue;  // it was CFL-bound
+        if (r[k - 1].dt > cfl_bound_under_gravity(setup.params, v_before) * (1 - 1e-5)) continue;  // it was CFL-bound
         const double growth = r[k].dt / r[k - 1].dt;
         ++checked;
         CHECK(growth <= 1.25 * (1 + 1e-6));

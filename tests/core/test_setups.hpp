@@ -11,6 +11,7 @@
 #include "algorithms/simulation.hpp"
 #include "algorithms/sph_kernels.hpp"
 #include "apps/scene_builder.hpp"
+#include "backend/backend.hpp"
 #include "backend/backend_registry.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/kdtree.hpp"
@@ -65,6 +66,14 @@ inline long add_box_solid(SimulationSetup& setup, Vec3d size, Vec3d centre, cons
     return std::count(removed.begin(), removed.end(), 1);
 }
 
+// create_openmp_simulation(setup, n) sets the thread count of the whole process (omp_set_num_threads)
+// and n = 0 keeps whatever it is, so a test that picks a thread count puts the previous one back:
+// otherwise every later test in the program would run on that count.
+struct RestoreThreadCount {
+    const int saved = openmp_backend::thread_count();
+    ~RestoreThreadCount() { openmp_backend::set_threads(saved); }
+};
+
 // Steps `sim` `steps` times and returns its particles.
 inline HostParticles run_steps(Simulation& sim, int steps) {
     for (int s = 0; s < steps; ++s) sim.step();
@@ -75,7 +84,7 @@ inline HostParticles run_steps(Simulation& sim, int steps) {
 
 // `setup` run for the same number of steps on OpenMP (at the current thread count), then on CUDA:
 // the particles and the last step's report of each. The caller checks cuda_backend_info().available
-// first, and skips with a "SKIPPED: " message where it is not.
+// first, and skips (MW_SKIP, tests/skip.hpp) where it is not.
 struct OpenmpAndCuda {
     HostParticles openmp, cuda;
     StepReport openmp_report, cuda_report;
@@ -200,6 +209,50 @@ inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std:
     }
     for (const auto& [index, sum] : layers) out.worst_layer = std::max(out.worst_layer, std::fabs(sum.first / sum.second));
     out.layers = layers.size();
+    return out;
+}
+
+// A fluid column at rest, measured as test_hydrostatic.cpp measures it: `sim` (a column `width`
+// square from x = z = 0, its fluid standing on `bottom`) is stepped `steps` times; over the last
+// `averaged` steps the largest reported mean density error is kept and the smoothed pressure summed
+// (add_smoothed_pressure), and after the last step the column's height H (the highest fluid centre
+// + r0/2) and its hydrostatic_profile against ρ0 g (H - y) over the interior: 2 h = 4 r0 clear of
+// the side walls, of `bottom` and of the surface, where the free surface and the walls' truncated
+// kernel sums do not reach.
+struct SettledColumn {
+    HostParticles particles;  // after the last step
+    double worst_avg_error = 0, H = 0;
+    HydrostaticProfile profile;
+};
+// `on_step(step, report, particles)` runs after every step with its report; `particles` is the
+// download made on the averaged steps, and on every `download_every`th step before them (0: none),
+// and null on the other steps.
+using OnSettleStep = std::function<void(int step, const StepReport& report, const HostParticles* particles)>;
+inline SettledColumn settle_column(Simulation& sim, const SimulationParams& params, int steps, int averaged,
+                                   double bottom, Real width, int download_every, const OnSettleStep& on_step) {
+    const Real r0 = params.fluid.spacing;
+    const CubicSpline3D kernel = CubicSpline3D::with_support(params.fluid.support_radius);
+    SettledColumn out;
+    std::vector<double> smoothed_sum;
+    for (int step = 0; step < steps; ++step) {
+        sim.step();
+        const bool in_average = step >= steps - averaged;
+        const bool download = in_average || (download_every > 0 && step % download_every == 0);
+        if (download) sim.download(out.particles);
+        if (on_step) on_step(step, sim.last_report(), download ? &out.particles : nullptr);
+        if (!in_average) continue;
+        out.worst_avg_error = std::max(out.worst_avg_error, sim.last_report().density_error_avg);
+        add_smoothed_pressure(out.particles, kernel, smoothed_sum);
+    }
+    const HostParticles& p = out.particles;
+    double top = 0;
+    for (std::size_t i = 0; i < p.position.size(); ++i)
+        if (p.type[i] == kFluid) top = std::max(top, double(p.position[i].y));
+    out.H = top + r0 / 2;
+    const double rho_g = double(params.fluid.rest_density) * -double(params.gravity.y), margin = 2 * 2 * r0;
+    out.profile = hydrostatic_profile(p, smoothed_sum, averaged, rho_g, bottom, out.H, r0,
+                                      Vec3{Real(margin), Real(bottom + margin), Real(margin)},
+                                      Vec3{Real(width - margin), Real(out.H - margin), Real(width - margin)});
     return out;
 }
 

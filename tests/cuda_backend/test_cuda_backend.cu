@@ -1,8 +1,8 @@
 // The CUDA backend's primitives against plain sequential answers: the checks of
 // tests/core/backend_primitives.hpp compiled for the GPU. Built only with the CUDA backend; each
 // case skips with a message where no CUDA device is present (CI).
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
-#include <doctest/doctest.h>
+#define DOCTEST_CONFIG_IMPLEMENT
+#include "tests/skip.hpp"
 
 #define MW_BACKEND_CUDA
 #include "../core/backend_primitives.hpp"
@@ -10,7 +10,7 @@
 namespace {
 bool gpu_present() {
     if (mw::backend_available()) return true;
-    MESSAGE("SKIPPED: no usable CUDA device (" << mw::unavailable_reason() << ")");
+    MW_SKIP("no usable CUDA device (" << mw::unavailable_reason() << ")");
     return false;
 }
 }  // namespace
@@ -30,3 +30,5 @@ TEST_CASE("CUDA atomics lose no update") {
 TEST_CASE("CUDA memory ledger follows allocations") {
     if (gpu_present()) mw::test::check_memory_ledger();
 }
+
+MW_TEST_MAIN

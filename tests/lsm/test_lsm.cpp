@@ -17,6 +17,7 @@
 #include "algorithms/solid_bodies.hpp"
 #include "lsm_helpers.hpp"
 #include "sampling/obj_loader.hpp"
+#include "tests/skip.hpp"
 
 using namespace mw;
 using namespace lsm_test;
@@ -703,7 +704,7 @@ TEST_CASE("no NaN and bounded energy at dt = 0.03 s: densities 100 to 10000, and
 
 TEST_CASE("CUDA against OpenMP: swaying pinned bunny, 100 steps") {
     if (!cuda_backend_info().available) {
-        MESSAGE("SKIPPED: no CUDA device (" << cuda_backend_info().description << ")");
+        MW_SKIP("no CUDA device (" << cuda_backend_info().description << ")");
         return;
     }
     const std::string bunny = std::string(MW_SHARED_DIR) + "/assets/meshes/stanford-bunny.obj";

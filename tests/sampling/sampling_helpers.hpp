@@ -8,6 +8,7 @@
 #include <doctest/doctest.h>
 
 #include "backend/errors.hpp"
+#include "tests/skip.hpp"
 
 namespace mwtest {
 inline std::string mesh_dir() { return std::string(MW_SHARED_DIR) + "/assets/meshes"; }
@@ -15,7 +16,7 @@ inline std::string mesh_dir() { return std::string(MW_SHARED_DIR) + "/assets/mes
 inline bool missing_mesh(const std::string& file) {
     const std::string path = mesh_dir() + "/" + file;
     if (std::filesystem::exists(path)) return false;
-    MESSAGE("SKIPPED: " << path << " is absent (the shared meshes live in ../shared/assets/meshes)");
+    MW_SKIP(path << " is absent (the shared meshes live in ../shared/assets/meshes)");
     return true;
 }
 

@@ -1,23 +1,25 @@
 // Meshes: procedural makers, transforms, OBJ loading and every kind of bad input.
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <doctest/doctest.h>
-#include <unistd.h>
 
 #include "backend/errors.hpp"
 #include "sampling/mesh.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling_helpers.hpp"
+#include "tests/scratch_dir.hpp"
 
 using namespace mw;
 using mwtest::error_of;
 
 namespace {
+// This program's scratch directory (tests/scratch_dir.hpp).
+std::filesystem::path scratch_dir() { return mw_test::scratch_dir("mw_sampling_test"); }
+
 void check_closed_outward(const TriangleMesh& m, double expected_volume, double rel_tol) {
     const EdgeReport e = edge_report(m);
     CHECK(e.boundary_edges == 0);
@@ -112,15 +114,12 @@ TEST_CASE("bad mesh input gives one clear error naming the file and the problem"
     const std::string bad_index = error_of([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "index.obj"); });
     CHECK(bad_index.rfind("index.obj: ", 0) == 0);
     // Via a real file as well (NaN written by a tool).
-    const std::string path =
-        (std::filesystem::temp_directory_path() / ("mw_sampling_nan_test_" + std::to_string(::getpid()) + ".obj"))
-            .string();
+    const std::string path = (scratch_dir() / "nan.obj").string();
     {
         std::ofstream f(path);
         f << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 inf\n" << tet_faces;
     }
     CHECK(error_of([&] { load_obj(path); }).rfind(path + ": vertex 4 is not finite", 0) == 0);
-    std::filesystem::remove(path);
 }
 
 TEST_CASE("malformed OBJ lines are named by their line, never misreported or dropped") {

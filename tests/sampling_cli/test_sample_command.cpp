@@ -1,6 +1,6 @@
 // `meltwater sample` end to end: output files and their fields, and one clear error with a
 // non-zero exit for every kind of bad input.
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+#define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
 #include <unistd.h>
 
@@ -15,6 +15,8 @@
 #include <string>
 
 #include "tests/sampling/sampling_helpers.hpp"
+#include "tests/scratch_dir.hpp"
+#include "tests/skip.hpp"
 
 namespace {
 
@@ -47,10 +49,12 @@ std::string read_file(const std::filesystem::path& p) {
     return s.str();
 }
 
+// This program's scratch directory (tests/scratch_dir.hpp).
+std::filesystem::path scratch_dir() { return mw_test::scratch_dir("mw_sample_cli"); }
+
+// An empty directory `name` of the scratch directory, one per test case.
 std::filesystem::path temp_dir(const std::string& name) {
-    // The process id keeps two builds' suites, run at once, out of each other's files.
-    const auto d = std::filesystem::temp_directory_path() /
-                   ("mw_sample_cli_" + std::to_string(::getpid()) + "_" + name);
+    const auto d = scratch_dir() / name;
     std::filesystem::remove_all(d);
     std::filesystem::create_directories(d);
     return d;
@@ -88,7 +92,7 @@ TEST_CASE("sample writes SBP, IBP and GP files with type codes and normals, and 
 TEST_CASE("sample on the real bunny, scaled, transformed") {
     const std::string bunny = std::string(MW_SHARED_DIR) + "/assets/meshes/stanford-bunny.obj";
     if (!std::filesystem::exists(bunny)) {
-        MESSAGE("SKIPPED: " << bunny << " is absent (the shared meshes live in ../shared/assets/meshes)");
+        MW_SKIP(bunny << " is absent (the shared meshes live in ../shared/assets/meshes)");
         return;
     }
     const auto dir = temp_dir("bunny");
@@ -204,3 +208,5 @@ TEST_CASE("--out is made and checked before sampling, and removed again when sam
     CHECK(read_file(dir / "kept" / "notes.txt") == "mine");
     std::filesystem::remove_all(dir);
 }
+
+MW_TEST_MAIN
