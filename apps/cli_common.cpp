@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <set>
 
 #include "apps/scene_builder.hpp"
 #include "backend/backend_registry.hpp"
@@ -26,11 +27,28 @@ std::string quoted_token(const std::string& message) {
     return message;
 }
 
-// Whether a token reads as an option rather than a value: "--quiet", "-q". Negative numbers
-// ("-5", "-1,0,0" for --translate) are values.
-bool looks_like_option(const std::string& token) {
-    return token.rfind("--", 0) == 0 ||
-           (token.size() >= 2 && token[0] == '-' && std::isalpha(static_cast<unsigned char>(token[1])));
+// Whether a word reads as an option rather than a value: "--quiet", "-q". Numbers ("-5",
+// "-inf") and lists of them ("-1,0,0" for --translate) are values.
+bool looks_like_option(const std::string& word) {
+    if (word.size() < 2 || word[0] != '-') return false;
+    if (word[1] == '-') return true;
+    double number = 0;
+    const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), number);
+    const bool starts_with_number = error == std::errc() || error == std::errc::result_out_of_range;
+    return !starts_with_number && std::isalpha(static_cast<unsigned char>(word[1]));
+}
+
+// The spellings ("--steps", "-s") of the options that take their value as the next word: all but
+// the flags, which have an implicit value.
+std::set<std::string> options_taking_a_value(const cxxopts::Options& options) {
+    std::set<std::string> names;
+    for (const std::string& group : options.groups())
+        for (const cxxopts::HelpOptionDetails& option : options.group_help(group).options) {
+            if (option.has_implicit) continue;
+            if (!option.s.empty()) names.insert("-" + option.s);
+            for (const std::string& name : option.l) names.insert("--" + name);
+        }
+    return names;
 }
 }  // namespace
 
@@ -58,14 +76,19 @@ cxxopts::ParseResult parse_options(cxxopts::Options& options, int argc, char** a
             rest.push_back(argv[i]);
         }
     }
+    // cxxopts gives an option that takes a value the next word whatever it is: `--steps --quiet`
+    // would make "--quiet" the step count, `--out -q` a directory named "-q". A value written with
+    // '=' (`--out=-q`) or after "--" is taken as written.
+    const std::set<std::string> takes_value = options_taking_a_value(options);
+    for (std::size_t i = 1; i + 1 < rest.size(); ++i) {
+        const std::string word = rest[i], next = rest[i + 1];
+        if (word == "--") break;
+        if (takes_value.count(word) && looks_like_option(next))
+            throw InputError(word + " needs a value, but is followed by the option '" + next + "'");
+        if (takes_value.count(word)) ++i;  // its value, whatever it looks like, is not an option
+    }
     try {
         cxxopts::ParseResult result = options.parse(static_cast<int>(rest.size()), rest.data());
-        // cxxopts gives an option that takes a value the next token whatever it is: `--steps
-        // --quiet` would make "--quiet" the step count, `--out -q` a directory named "-q".
-        for (const cxxopts::KeyValue& given : result.arguments())
-            if (looks_like_option(given.value()))
-                throw InputError("--" + given.key() + " needs a value, but is followed by the option '" +
-                                 given.value() + "'");
         if (!result.unmatched().empty()) {
             const std::string hint = overrides ? " (one scene at most)" : "";
             throw InputError("unexpected argument '" + result.unmatched().front() + "'" + hint);

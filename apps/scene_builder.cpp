@@ -118,7 +118,8 @@ void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& pl
         const std::vector<std::uint8_t> inside = classify_points(b.mesh, candidates);
         for (std::size_t c = 0; c < candidates.size(); ++c) inside_count[owner[c]][j] += inside[c];
     }
-    // The first overlapping pair in scene order is reported.
+    // The first overlapping pair of objects in scene order is reported (after every object's
+    // static-box check above).
     for (std::size_t k = 0; k < n; ++k)
         for (std::size_t j = 0; j < n; ++j)
             if (inside_count[k][j] > 0)

@@ -96,6 +96,11 @@ TEST_CASE("bad input: command line") {
     // An option where a value should be is not taken as the value (cxxopts would take it).
     check_rejected(run("run " + tiny() + " --steps --quiet"), {"--steps", "needs a value", "'--quiet'"});
     check_rejected(run("run " + tiny() + " --steps 1 --out -q"), {"--out", "needs a value", "'-q'"});
+    // ... but a value written with '=' or after "--" is taken as written, and numbers are values.
+    check_rejected(run("info " + tiny() + " --backend=-x"), {"--backend", "expected auto, cuda or openmp", "'-x'"});
+    check_rejected(run("info -- -x.json"), {"-x.json", "cannot open"});
+    check_rejected(run("run " + tiny() + " --time -inf"), {"--time", "finite", "'-inf'"});
+    check_rejected(run("run " + tiny() + " --steps -3"), {"--steps", "at least 1", "-3"});
     check_rejected(run("sample x --spacing abc --out " + scratch_dir() + "/never"), {"--spacing", "'abc'"});
     check_rejected(run("sample x --spacing 0.1 --directions three --out " + scratch_dir() + "/never"),
                    {"--directions", "'three'"});
@@ -273,11 +278,21 @@ TEST_CASE("bad input: a moving object that starts inside another object or a sta
                    {"objects[0]", "overlaps objects[1]", "4 of its 8 inner particles"});
     check_rejected(run("info " + scene("in_box", cube("elastic", 0.08), R"({"min": [0.075, 0.12, 0.12], "max": [0.2, 0.2, 0.2]})")),
                    {"objects[0]", "overlaps static_boxes[0]", "4 of its 8"});
-    // A static object with a moving one sunk into it, beside a third object apart from both: the
-    // pair is named, in scene order, whichever meshes were tested together.
-    check_rejected(run("info " + scene("three", cube("elastic", 0.02) + "," + cube("static", 0.08) + "," +
-                                                    cube("rigid", 0.1))),
+    // Three objects, one mesh tested against the inner particles of both others at once: a static
+    // cube turned 45 degrees about z (a diamond 0.0283 m from centre to corner in x and y, at
+    // (0.1, 0.16)); a rigid cube sunk into it, whose four inner particles at x = 0.11 lie inside it;
+    // and an elastic cube beside it whose two inner particles at (0.075, 0.135) lie inside the
+    // diamond's bounding box but outside the diamond, so they are tested and must not count.
+    const std::string diamond = R"({"kind": "static", "mesh": {"procedural": "box:x=0.04,y=0.04,z=0.04"},
+                   "transform": {"rotation_deg": [0, 0, 45], "translation": [0.1, 0.16, 0.16]}})";
+    const std::string beside = R"({"kind": "elastic", "mesh": {"procedural": "box:x=0.04,y=0.04,z=0.04"},
+                   "transform": {"translation": [0.065, 0.125, 0.16]}})";
+    const std::string sunk = R"({"kind": "rigid", "mesh": {"procedural": "box:x=0.04,y=0.04,z=0.04"},
+                   "transform": {"translation": [0.12, 0.16, 0.16]}})";
+    check_rejected(run("info " + scene("three", beside + "," + sunk + "," + diamond)),
                    {"objects[1]", "overlaps objects[2]", "4 of its 8 inner particles"});
+    // Without the sunk cube the scene is accepted: the elastic cube's two candidates are outside.
+    CHECK(run("info " + scene("two", beside + "," + diamond)).code == 0);
     // Touching is fine, and so are static solids sunk into one another (scenery).
     CHECK(run("info " + scene("touching", cube("elastic", 0.08) + "," + cube("elastic", 0.12))).code == 0);
     CHECK(run("info " + scene("static_pair", cube("static", 0.08) + "," + cube("static", 0.1),

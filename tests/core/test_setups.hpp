@@ -216,7 +216,7 @@ inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std:
 // square from x = z = 0, its fluid standing on `bottom`) is stepped `steps` times; over the last
 // `averaged` steps the largest reported mean density error is kept and the smoothed pressure summed
 // (add_smoothed_pressure), and after the last step the column's height H (the highest fluid centre
-// + r0/2) and its hydrostatic_profile against ρ0 g (H - y) over the interior: 2 h = 4 r0 clear of
+// + r0/2) and its hydrostatic_profile against ρ0 g (H - y) over the interior: 2 h clear of
 // the side walls, of `bottom` and of the surface, where the free surface and the walls' truncated
 // kernel sums do not reach.
 struct SettledColumn {
@@ -249,7 +249,8 @@ inline SettledColumn settle_column(Simulation& sim, const SimulationParams& para
     for (std::size_t i = 0; i < p.position.size(); ++i)
         if (p.type[i] == kFluid) top = std::max(top, double(p.position[i].y));
     out.H = top + r0 / 2;
-    const double rho_g = double(params.fluid.rest_density) * -double(params.gravity.y), margin = 2 * 2 * r0;
+    const double rho_g = double(params.fluid.rest_density) * -double(params.gravity.y),
+                 margin = 2 * double(params.fluid.support_radius);
     out.profile = hydrostatic_profile(p, smoothed_sum, averaged, rho_g, bottom, out.H, r0,
                                       Vec3{Real(margin), Real(bottom + margin), Real(margin)},
                                       Vec3{Real(width - margin), Real(out.H - margin), Real(width - margin)});
