@@ -132,8 +132,11 @@ class SolidBodies {
         const InterpolationData g = interpolation(store);
         interpolate_geometry(g, dt);
         interpolate_surface(g);
-        return summarize_solids(d);
+        return summary(store);
     }
+
+    // The IBPs' kinetic energy, top speed and first non-finite slot (a reduction read back).
+    SolidSummary summary(ParticleStore& store) { return summarize_solids(data(store)); }
 
     // The current goal of every IBP (slot order), without changing anything but the warm-start
     // rotations (tests).

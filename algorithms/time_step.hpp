@@ -360,6 +360,16 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     if (use_lists_)
         lists_.build(grid_.view(), ranges_.fluid_end, store_.position.cview(), fluid_.kernel.h, neighbor_count_->view());
 
+    // The reductions a step reads back (the density error, the motion summaries) make their
+    // workspaces on first use: on a GPU a device result, a pinned host slot and CUB's temporary
+    // storage, on CPU cores the per-chunk partials. One call of each here, so that the first step
+    // allocates nothing either.
+    if (has_fluid_) {
+        density_error(ranges_.fluid_end, store_.density.cview(), fluid_.rest_density);
+        summarize_motion(ranges_.fluid_end, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
+    }
+    if (solids_.active()) solids_.summary(store_);
+
     // The first CFL step uses the initial speeds.
     double max_speed2 = 0;
     for (std::size_t k = 0; k < moving; ++k) max_speed2 = std::max(max_speed2, double(norm2(velocity[k])));
