@@ -127,15 +127,15 @@ inline ListFillSummary NeighborList::fill(const GridView& grid, std::size_t flui
     // Branch-free fill (whether a candidate is in range is unpredictable; with a branch the fill
     // took 2.7 times as long as a counting pass, without one 1.6 times): every candidate is
     // written, the cursor advances only for those in range. Past the row's last slot, writes go
-    // to that last slot, so they never touch the next row, which another thread may be filling
-    // (a row has at least kRowSlack slots, and a row that overflowed is filled again). Not to a
-    // local dummy: its address would put it in memory (local memory on a GPU) for every write.
+    // to a local dummy, so they never touch the next row, which another thread may be filling.
     parallel_for("neighbor_list_fill", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i];
         const std::uint32_t first = offsets[i], last = offsets[i + 1];
         std::uint32_t k = first;
+        std::uint32_t dummy = 0;
         auto add = [&](std::uint32_t j) {
-            indices[k < last ? k : last - 1] = j;
+            std::uint32_t* slot = k < last ? indices + k : &dummy;
+            *slot = j;
             k += norm2(xi - position[j]) < r2;
         };
         grid.for_each_fluid(xi, add);
