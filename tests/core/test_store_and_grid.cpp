@@ -220,6 +220,22 @@ TEST_CASE("neighbour lists stay exact when counts grow past their slack") {
     lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
     CHECK(lists.second_fills() == 2);
     CHECK(list_pairs(lists.view(), store.id.to_host()) == nanoflann_pairs(points, h));
+    // 4. Rows exactly full: each row laid out for exactly its count (last count minus the slack, so
+    // that the slack brings it back). The fill goes on testing candidates after a row's last slot
+    // is taken; none of them may overwrite it. (Writing them to the row's last slot instead of a
+    // scratch variable once did, and no other test saw it.)
+    grid.build(store);
+    std::vector<std::uint32_t> exact = row_counts.to_host();
+    long full_rows = 0;
+    for (std::uint32_t& count : exact) {
+        full_rows += count >= NeighborList::kRowSlack;
+        count = count >= NeighborList::kRowSlack ? count - NeighborList::kRowSlack : 0;
+    }
+    REQUIRE(full_rows > long(n) / 2);
+    row_counts.upload(exact);
+    lists.build(grid.view(), n, store.position.cview(), h, row_counts.view());
+    CHECK(lists.second_fills() == 2);  // exactly full is not overflowing
+    CHECK(list_pairs(lists.view(), store.id.to_host()) == nanoflann_pairs(points, h));
 }
 
 TEST_CASE("particles outside the grid are set aside, not lost silently") {
