@@ -212,28 +212,29 @@ void check_host_memory(const Scene& scene, const std::string& backend, bool host
                           format_bytes(available) + " is available; increase fluid.spacing or shrink the scene");
 }
 
+namespace {
+// All of `text` as a T (std::from_chars: no leading '+', no whitespace and no locale, so "2.5"
+// means 2.5 everywhere), or an InputError naming the option and the `expected` kind of value.
+template <class T>
+T option_value(const std::string& name, const std::string& text, const char* expected) {
+    T value{};
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error == std::errc::result_out_of_range) throw InputError("--" + name + ": '" + text + "' is out of range");
+    if (error != std::errc() || end != text.data() + text.size() || text.empty())
+        throw InputError("--" + name + ": expected " + expected + ", got '" + text + "'");
+    return value;
+}
+}  // namespace
+
 long integer_option(const cxxopts::ParseResult& args, const std::string& name, long fallback) {
     if (!args.count(name)) return fallback;
-    const std::string text = args[name].as<std::string>();
-    long value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error == std::errc::result_out_of_range)
-        throw InputError("--" + name + ": '" + text + "' is out of range");
-    if (error != std::errc() || end != text.data() + text.size() || text.empty())
-        throw InputError("--" + name + ": expected a whole number, got '" + text + "'");
-    return value;
+    return option_value<long>(name, args[name].as<std::string>(), "a whole number");
 }
 
 double number_option(const cxxopts::ParseResult& args, const std::string& name, double fallback) {
     if (!args.count(name)) return fallback;
     const std::string text = args[name].as<std::string>();
-    double value = 0;
-    // from_chars reads no leading '+', no whitespace and no locale: "2.5" means 2.5 everywhere.
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error == std::errc::result_out_of_range)
-        throw InputError("--" + name + ": '" + text + "' is out of range");
-    if (error != std::errc() || end != text.data() + text.size() || text.empty())
-        throw InputError("--" + name + ": expected a number, got '" + text + "'");
+    const double value = option_value<double>(name, text, "a number");
     if (!std::isfinite(value)) throw InputError("--" + name + ": expected a finite number, got '" + text + "'");
     return value;
 }
