@@ -9,6 +9,7 @@
 #pragma once
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/sph_kernels.hpp"
+#include "algorithms/wall_mirror.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -20,6 +21,7 @@ struct FluidConstants {
     Real viscosity = 0;       // μ
     Real wall_viscosity = 0;  // μ of the fluid–wall friction (Eq. 8 against boundary particles)
     Vec3 gravity{0, 0, 0};
+    WallMirrors mirrors;      // the domain's free-slip walls, for Eq. 4 next to them
 };
 
 struct DensityError {
@@ -56,31 +58,37 @@ inline void compute_boundary_volumes(GridView grid, View<const Vec3> position, V
 // Non-pressure acceleration of fluid: gravity, viscosity (the paper's Eq. 4 with the Müller
 // viscosity Laplacian, which is never negative) and friction against boundary particles (Eq. 8,
 // ψ_b = ρ0 V_b, ρ_b = ρ0: a_i += μ_w V_b/ρ0 (v_b - v_i) ∇²W). Densities are the previous step's.
-inline void compute_viscosity_acceleration(GridView grid, std::size_t fluid_count, View<const Vec3> position,
-                                           View<const Vec3> velocity, View<const Real> density,
-                                           View<const Real> boundary_volume, View<Vec3> acceleration,
-                                           FluidConstants c) {
-    const bool walls = c.wall_viscosity > Real(0);
+// Next to the domain's free-slip walls, Eq. 4 also sums over the fluid's mirror images beyond
+// them (wall_mirror.hpp), so the layer h thick along a wall keeps its full viscous stress. Each
+// pair (i, j) then also meets through the images, with the same weight both ways
+// (|x_i - x_j'| = |x_j - x_i'|), and adds -μ V_i V_j ∇²W |v_i - v_j'|² to the power: never
+// positive, like the fluid pairs.
+// Written against the gather interface (grid or lists); every term is 0 by itself for a pair out
+// of range and for i itself (v_i - v_i), so no test is needed. (i's own image is not 0: it brakes
+// i's velocity into the wall, which the fluid pairs cannot see when all move alike.)
+template <class Neighbors>
+void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> position,
+                                    View<const Vec3> velocity, View<const Real> density,
+                                    View<const Real> boundary_volume, View<Vec3> acceleration, FluidConstants c) {
+    const bool friction = c.wall_viscosity > Real(0);
     parallel_for("viscosity", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i], vi = velocity[i];
-        Vec3 sum{0, 0, 0}, wall_sum{0, 0, 0};
-        grid.for_each_fluid(xi, [&](std::uint32_t j) {
-            const Vec3 d = xi - position[j];
-            const Real r2 = norm2(d);
-            if (r2 >= c.support2 || j == i) return;
-            sum += (c.kernel.laplacian_visc(std::sqrt(r2)) / density[j]) * (velocity[j] - vi);
+        Vec3 fluid_sum = neighbors.sum_fluid(i, xi, [&](std::uint32_t j) {
+            return (c.kernel.laplacian_visc_r2(norm2(xi - position[j])) / density[j]) * (velocity[j] - vi);
         });
-        if (walls) {
-            auto friction = [&](std::uint32_t b) {
-                const Real r2 = norm2(xi - position[b]);
-                if (r2 < c.support2)
-                    wall_sum += (boundary_volume[b] * c.kernel.laplacian_visc(std::sqrt(r2))) * (velocity[b] - vi);
-            };
-            grid.for_each_static(xi, friction);
-            grid.for_each_solid(xi, friction);
-        }
-        acceleration[i] = c.gravity + (c.viscosity * c.mass / density[i]) * sum +
-                          (c.wall_viscosity / c.rest_density) * wall_sum;
+        c.mirrors.for_each_reflection(xi, [&](Vec3 scale, Vec3 offset) {
+            fluid_sum += neighbors.sum_fluid(i, xi, [&](std::uint32_t j) {
+                const Vec3 image = offset + hadamard(scale, position[j]);
+                return (c.kernel.laplacian_visc_r2(norm2(xi - image)) / density[j]) *
+                       (hadamard(scale, velocity[j]) - vi);
+            });
+        });
+        Vec3 a = c.gravity + (c.viscosity * c.mass / density[i]) * fluid_sum;
+        if (friction)
+            a += (c.wall_viscosity / c.rest_density) * neighbors.sum_boundary(i, xi, [&](std::uint32_t b) {
+                return (boundary_volume[b] * c.kernel.laplacian_visc_r2(norm2(xi - position[b]))) * (velocity[b] - vi);
+            });
+        acceleration[i] = a;
     });
 }
 

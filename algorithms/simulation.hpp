@@ -49,6 +49,9 @@ inline double default_eta_max(double eta) {
 struct SimulationParams {
     Vec3 domain_min{0, 0, 0};
     Vec3 domain_max{1, 1, 1};
+    // Whether the domain's faces are lined with static wall particles (the scenes' boundary.walls).
+    // Then they are free-slip walls, and Eq. 4 next to them sums over the fluid's mirror images too.
+    bool domain_walls = false;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

@@ -62,6 +62,11 @@ struct CubicSpline3D {
     }
     // Laplacian of the viscosity kernel; never negative, so viscosity never injects energy.
     MW_INLINE Real laplacian_visc(Real r) const { return r < h ? visc_scale * (h - r) : Real(0); }
+    // The same from r², branch-free like W_r2 (0 out of range by itself).
+    MW_INLINE Real laplacian_visc_r2(Real r2) const {
+        const Real gap = h - std::sqrt(r2);
+        return visc_scale * (gap > Real(0) ? gap : Real(0));
+    }
 };
 
 // Cubic spline normalised in 2D (for 2D scenes and the 2D δ check).

@@ -54,9 +54,14 @@ class BackendSimulation final : public Simulation {
         // 3. Non-pressure forces: gravity, viscosity (Eq. 4), wall friction (Eq. 8).
         if (has_viscosity_) {
             timers_.start(kViscosity);
-            compute_viscosity_acceleration(grid, fluid_count, store_.position.cview(), store_.velocity.cview(),
-                                           store_.density.cview(), boundary_volume_.cview(), nonpressure_.view(),
-                                           fluid_);
+            if (use_lists_)
+                compute_viscosity_acceleration(lists_.view(), fluid_count, store_.position.cview(),
+                                               store_.velocity.cview(), store_.density.cview(),
+                                               boundary_volume_.cview(), nonpressure_.view(), fluid_);
+            else
+                compute_viscosity_acceleration(grid, fluid_count, store_.position.cview(), store_.velocity.cview(),
+                                               store_.density.cview(), boundary_volume_.cview(), nonpressure_.view(),
+                                               fluid_);
             timers_.stop(kViscosity);
         }
         const Vec3* nonpressure = has_viscosity_ ? nonpressure_.view().data() : nullptr;
@@ -314,6 +319,8 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     fluid_.viscosity = fp.viscosity;
     fluid_.wall_viscosity = fp.wall_viscosity;
     fluid_.gravity = params_.gravity;
+    if (params_.domain_walls && fp.viscosity > 0)
+        fluid_.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::kAllFaces, h};
     // Mass such that the prototype lattice at spacing r0 has exactly the rest density.
     const PrototypeSums sums = prototype_sums(fluid_.kernel, fp.spacing, 3);
     fluid_.mass = static_cast<Real>(fp.rest_density / sums.sum_W);

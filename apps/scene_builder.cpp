@@ -166,6 +166,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         block_end.push_back(setup.position.size());
     }
     const Real rb = scene.boundary_spacing();
+    setup.params.domain_walls = scene.walls;
     if (scene.walls)
         // First layer kWallGap r0 outside the faces: fluid blocks touching a wall start at rest density.
         append(setup,

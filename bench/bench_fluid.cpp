@@ -108,6 +108,7 @@ SimulationSetup dam_break(long target, CellOrdering ordering) {
         s.position.push_back(p);
         s.type.push_back(kFluid);
     }
+    s.params.domain_walls = true;
     for (const Vec3& p : sample_container_walls(s.params.domain_min, s.params.domain_max, r0 / 2, 1, kWallGap * r0)) {
         s.position.push_back(p);
         s.type.push_back(kStaticBoundary);

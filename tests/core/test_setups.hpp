@@ -35,6 +35,7 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
         setup.position.push_back(p);
         setup.type.push_back(kFluid);
     }
+    setup.params.domain_walls = walls;
     if (walls) {
         for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, kWallGap * r0)) {
             setup.position.push_back(p);
@@ -185,19 +186,24 @@ inline void add_smoothed_pressure(const HostParticles& p, const CubicSpline3D& k
 }
 
 // A settled column's pressure against p(y) = ρ0 g (top - y) over [bottom, top]: the smoothed
-// pressure averaged over `averaged` steps (smoothed_sum / averaged) for the fluid particles inside
-// `interior`, as a deviation relative to ρ0 g (top - bottom), averaged per layer r0 thick.
+// pressure averaged over `averaged` steps (smoothed_sum / averaged) for the fluid particles whose
+// position averaged over the same steps (mean_position) is inside `interior`, as a deviation
+// relative to ρ0 g (top - bottom), averaged per layer r0 thick. `top` is the column's height
+// averaged over those steps too: a column still settling can move particles by up to r0 within
+// the window, so comparing the window's pressure with the last step's heights would measure the
+// motion, not the profile.
 struct HydrostaticProfile {
     double worst_layer = 0, worst_particle = 0;
     std::size_t layers = 0;
 };
 inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std::vector<double>& smoothed_sum,
-                                              int averaged, double rho_g, double bottom, double top, double r0,
-                                              Vec3 interior_lo, Vec3 interior_hi) {
+                                              const std::vector<Vec3>& mean_position, int averaged, double rho_g,
+                                              double bottom, double top, double r0, Vec3 interior_lo,
+                                              Vec3 interior_hi) {
     std::map<int, std::pair<double, int>> layers;  // layer -> (sum of relative deviation, count)
     HydrostaticProfile out;
     for (std::size_t i = 0; i < p.position.size(); ++i) {
-        const Vec3 x = p.position[i];
+        const Vec3 x = mean_position[i];
         if (p.type[i] != kFluid || x.x < interior_lo.x || x.x > interior_hi.x || x.y < interior_lo.y ||
             x.y > interior_hi.y || x.z < interior_lo.z || x.z > interior_hi.z)
             continue;
@@ -214,14 +220,14 @@ inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std:
 
 // A fluid column at rest, measured as test_hydrostatic.cpp measures it: `sim` (a column `width`
 // square from x = z = 0, its fluid standing on `bottom`) is stepped `steps` times; over the last
-// `averaged` steps the largest reported mean density error is kept and the smoothed pressure summed
-// (add_smoothed_pressure), and after the last step the column's height H (the highest fluid centre
-// + r0/2) and its hydrostatic_profile against ρ0 g (H - y) over the interior: 2 h clear of
-// the side walls, of `bottom` and of the surface, where the free surface and the walls' truncated
-// kernel sums do not reach.
+// `averaged` steps the largest reported mean density error is kept, and the smoothed pressure
+// (add_smoothed_pressure), each particle's position and the column's height H (the highest fluid
+// centre + r0/2) are averaged; then the hydrostatic_profile against ρ0 g (H - y) over the
+// interior: 2 h clear of the side walls, of `bottom` and of the surface, where the free surface and
+// the walls' truncated kernel sums do not reach.
 struct SettledColumn {
     HostParticles particles;  // after the last step
-    double worst_avg_error = 0, H = 0;
+    double worst_avg_error = 0, H = 0;  // H: averaged over the last steps
     HydrostaticProfile profile;
 };
 // `on_step(step, report, particles)` runs after every step with its report; `particles` is the
@@ -234,6 +240,8 @@ inline SettledColumn settle_column(Simulation& sim, const SimulationParams& para
     const CubicSpline3D kernel = CubicSpline3D::with_support(params.fluid.support_radius);
     SettledColumn out;
     std::vector<double> smoothed_sum;
+    std::vector<double> position_sum;  // x, y, z of each particle, summed over the averaged steps
+    double top_sum = 0;
     for (int step = 0; step < steps; ++step) {
         sim.step();
         const bool in_average = step >= steps - averaged;
@@ -243,15 +251,26 @@ inline SettledColumn settle_column(Simulation& sim, const SimulationParams& para
         if (!in_average) continue;
         out.worst_avg_error = std::max(out.worst_avg_error, sim.last_report().density_error_avg);
         add_smoothed_pressure(out.particles, kernel, smoothed_sum);
+        const HostParticles& p = out.particles;
+        position_sum.resize(3 * p.position.size(), 0.0);
+        double top = 0;
+        for (std::size_t i = 0; i < p.position.size(); ++i) {
+            position_sum[3 * i] += p.position[i].x;
+            position_sum[3 * i + 1] += p.position[i].y;
+            position_sum[3 * i + 2] += p.position[i].z;
+            if (p.type[i] == kFluid) top = std::max(top, double(p.position[i].y));
+        }
+        top_sum += top;
     }
     const HostParticles& p = out.particles;
-    double top = 0;
+    std::vector<Vec3> mean_position(p.position.size());
     for (std::size_t i = 0; i < p.position.size(); ++i)
-        if (p.type[i] == kFluid) top = std::max(top, double(p.position[i].y));
-    out.H = top + r0 / 2;
+        mean_position[i] = Vec3{Real(position_sum[3 * i] / averaged), Real(position_sum[3 * i + 1] / averaged),
+                                Real(position_sum[3 * i + 2] / averaged)};
+    out.H = top_sum / averaged + r0 / 2;
     const double rho_g = double(params.fluid.rest_density) * -double(params.gravity.y),
                  margin = 2 * double(params.fluid.support_radius);
-    out.profile = hydrostatic_profile(p, smoothed_sum, averaged, rho_g, bottom, out.H, r0,
+    out.profile = hydrostatic_profile(p, smoothed_sum, mean_position, averaged, rho_g, bottom, out.H, r0,
                                       Vec3{Real(margin), Real(bottom + margin), Real(margin)},
                                       Vec3{Real(width - margin), Real(out.H - margin), Real(width - margin)});
     return out;
