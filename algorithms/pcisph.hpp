@@ -36,19 +36,16 @@ struct DensityErrorOp {
 
 // Akinci boundary volume V_b = 1 / Σ_k W(x_b - x_k) over boundary neighbours k (b included), for
 // particles [first, first + count). Static particles see static neighbours only (computed once);
-// moving solids see moving solids and static walls.
+// moving solids see moving solids and static walls. Branch-free terms (W_r2 is 0 out of range by
+// itself), as in the PCISPH sums: a boundary particle's neighbourhood is dense (walls at r0/2), and
+// whether a candidate is in range is unpredictable.
 inline void compute_boundary_volumes(GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
                                      std::size_t count, bool moving, SphKernel kernel) {
-    const Real h2 = kernel.h * kernel.h;
     parallel_for("boundary_volume", count, [=] MW_HD(std::size_t k) {
         const std::size_t b = first + k;
         const Vec3 xb = position[b];
         Real sum = 0;
-        auto add = [&](std::uint32_t j) {
-            const Vec3 d = xb - position[j];
-            const Real r2 = norm2(d);
-            if (r2 < h2) sum += kernel.W(std::sqrt(r2));
-        };
+        auto add = [&](std::uint32_t j) { sum += kernel.W_r2(norm2(xb - position[j])); };
         grid.for_each_static(xb, add);
         if (moving) grid.for_each_solid(xb, add);
         volume[b] = sum > Real(0) ? Real(1) / sum : Real(0);
