@@ -15,7 +15,6 @@ MW_BACKEND_BEGIN
 
 struct FluidConstants {
     SphKernel kernel;
-    Real support2 = 0;        // h²
     Real rest_density = 0;    // ρ0
     Real mass = 0;            // fluid particle mass
     Real viscosity = 0;       // μ
@@ -68,6 +67,7 @@ void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count
                                     View<const Vec3> velocity, View<const Real> density,
                                     View<const Real> boundary_volume, View<Vec3> acceleration, FluidConstants c) {
     const bool friction = c.wall_viscosity > Real(0);
+    const Real h2 = c.kernel.h * c.kernel.h;
     parallel_for("viscosity", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i], vi = velocity[i];
         Vec3 fluid_sum = neighbors.sum_fluid(i, xi, [&](std::uint32_t j) {
@@ -75,8 +75,12 @@ void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count
         });
         c.mirrors.for_each_reflection(xi, [&](Vec3 scale, Vec3 offset) {
             fluid_sum += neighbors.sum_fluid(i, xi, [&](std::uint32_t j) {
+                // Only images of neighbours within h: the grid offers more candidates than the
+                // lists, and a particle that strayed past a face could otherwise meet an image
+                // that its partner does not enumerate (wall_mirror.hpp).
+                const Real neighbour = norm2(xi - position[j]) < h2 ? Real(1) : Real(0);
                 const Vec3 image = offset + hadamard(scale, position[j]);
-                return (c.kernel.laplacian_visc_r2(norm2(xi - image)) / density[j]) *
+                return (neighbour * c.kernel.laplacian_visc_r2(norm2(xi - image)) / density[j]) *
                        (hadamard(scale, velocity[j]) - vi);
             });
         });

@@ -314,7 +314,6 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     grid_.build_static(store_);
 
     fluid_.kernel = SphKernel::with_support(h);
-    fluid_.support2 = h * h;
     fluid_.rest_density = fp.rest_density;
     fluid_.viscosity = fp.viscosity;
     fluid_.wall_viscosity = fp.wall_viscosity;

@@ -4,10 +4,14 @@
 // neighbours, so a particle within h of a wall would miss the fluid beyond it and feel up to half
 // the viscous stress it should. Beyond a free-slip plane the flow continues as its mirror image:
 // positions reflected across the plane, the normal velocity component reversed, the tangential
-// kept. A ghost of fluid particle j across a face is within h of particle i only if j is (the
-// reflection only lengthens the normal component of x_i - x_j, both being on the same side), so
-// the ghosts are found among i's own fluid neighbours. Near an edge or a corner, the images across
-// two or three faces at once count too.
+// kept. For two particles inside the domain, a reflection only lengthens the normal component of
+// x_i - x_j (both are on the same side of the face), so the image of j is within h of i only if j
+// is: the images are found among i's own fluid neighbours. Near an edge or a corner, the images
+// across two or three faces at once count too. (A fluid particle can stray a little past a face,
+// up to the wall particles; the caller keeps only images of particles within h of i, so grid and
+// lists give the same sums and every pair meets its image both ways.) On an axis narrower than h
+// the images across both of its faces are not combined (periodic images of the slab): domains
+// that thin are not a use case.
 //
 // A reflection is x' = offset + scale ⊙ x and v' = scale ⊙ v, with scale -1 and offset 2 p on each
 // reflected axis (plane at p) and scale 1, offset 0 on the others.
@@ -27,38 +31,38 @@ struct WallMirrors {
 
     // Calls f(scale, offset) once for every reflection, across one face or several, whose images
     // can come within `reach` of x; nothing for a particle farther than `reach` from every wall.
+    // Choices per axis: 0 keep, 1 reflect across the low face, 2 across the high one. No arrays
+    // indexed at run time, so that on a GPU it all stays in registers.
     template <class F>
     MW_INLINE void for_each_reflection(Vec3 x, F&& f) const {
         if (!faces) return;
-        Axis ax, ay, az;
-        ax.add(x.x, lo.x, hi.x, faces, reach);
-        ay.add(x.y, lo.y, hi.y, faces >> 2, reach);
-        az.add(x.z, lo.z, hi.z, faces >> 4, reach);
-        if (ax.count + ay.count + az.count == 3) return;  // the common case: no wall near
-        for (int a = 0; a < ax.count; ++a)
-            for (int b = 0; b < ay.count; ++b)
-                for (int c = 0; c < az.count; ++c)
-                    if (a + b + c > 0)
-                        f(Vec3{ax.scale[a], ay.scale[b], az.scale[c]}, Vec3{ax.offset[a], ay.offset[b], az.offset[c]});
+        const unsigned near_x = near_faces(x.x, lo.x, hi.x, faces);
+        const unsigned near_y = near_faces(x.y, lo.y, hi.y, faces >> 2);
+        const unsigned near_z = near_faces(x.z, lo.z, hi.z, faces >> 4);
+        if (!(near_x | near_y | near_z)) return;  // the common case: no wall near
+        for (int a = 0; a < 3; ++a) {
+            if (a && !(near_x & (1u << (a - 1)))) continue;
+            for (int b = 0; b < 3; ++b) {
+                if (b && !(near_y & (1u << (b - 1)))) continue;
+                for (int c = 0; c < 3; ++c) {
+                    if (c && !(near_z & (1u << (c - 1)))) continue;
+                    if (a + b + c == 0) continue;  // the particle itself, not an image
+                    f(Vec3{scale(a), scale(b), scale(c)}, Vec3{offset(a, lo.x, hi.x), offset(b, lo.y, hi.y),
+                                                               offset(c, lo.z, hi.z)});
+                }
+            }
+        }
     }
 
    private:
-    // The choices on one axis: keep (always), reflect across the low face, across the high face.
-    struct Axis {
-        int count = 1;
-        Real scale[3] = {1, 1, 1};
-        Real offset[3] = {0, 0, 0};
-        MW_INLINE void add(Real x, Real lo_face, Real hi_face, unsigned axis_faces, Real reach) {
-            if ((axis_faces & 1u) && x - lo_face < reach) {
-                scale[count] = -1;
-                offset[count++] = 2 * lo_face;
-            }
-            if ((axis_faces & 2u) && hi_face - x < reach) {
-                scale[count] = -1;
-                offset[count++] = 2 * hi_face;
-            }
-        }
-    };
+    // Bit 0: the axis' low face is a wall within reach of x; bit 1: the high one.
+    MW_INLINE unsigned near_faces(Real x, Real lo_face, Real hi_face, unsigned axis_faces) const {
+        return ((axis_faces & 1u) && x - lo_face < reach ? 1u : 0u) | ((axis_faces & 2u) && hi_face - x < reach ? 2u : 0u);
+    }
+    static MW_INLINE Real scale(int choice) { return choice ? Real(-1) : Real(1); }
+    static MW_INLINE Real offset(int choice, Real lo_face, Real hi_face) {
+        return choice == 1 ? 2 * lo_face : choice == 2 ? 2 * hi_face : Real(0);
+    }
 };
 
 }  // namespace mw
