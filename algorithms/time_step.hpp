@@ -51,7 +51,8 @@ class BackendSimulation final : public Simulation {
             timers_.stop(kSolidVolumes);
         }
 
-        // 3. Non-pressure forces: gravity, viscosity (Eq. 4), wall friction (Eq. 8).
+        // 3. Non-pressure forces: gravity, viscosity (Eq. 4, with the fluid's mirror images across
+        //    the domain walls), wall friction (Eq. 8).
         if (has_viscosity_) {
             timers_.start(kViscosity);
             if (use_lists_)

@@ -57,7 +57,9 @@ struct WallMirrors {
    private:
     // Bit 0: the axis' low face is a wall within reach of x; bit 1: the high one.
     MW_INLINE unsigned near_faces(Real x, Real lo_face, Real hi_face, unsigned axis_faces) const {
-        return ((axis_faces & 1u) && x - lo_face < reach ? 1u : 0u) | ((axis_faces & 2u) && hi_face - x < reach ? 2u : 0u);
+        const unsigned near_lo = (axis_faces & 1u) && x - lo_face < reach ? 1u : 0u;
+        const unsigned near_hi = (axis_faces & 2u) && hi_face - x < reach ? 2u : 0u;
+        return near_lo | near_hi;
     }
     static MW_INLINE Real scale(int choice) { return choice ? Real(-1) : Real(1); }
     static MW_INLINE Real offset(int choice, Real lo_face, Real hi_face) {
