@@ -20,7 +20,7 @@ class StepSizeControl {
 
     // The step to try next: in fixed mode solver.dt; in CFL mode min(limit, dt, bound), never
     // below min(dt_min, dt), where the bound is the largest Δt in which a particle at the last
-    // step's top speed v, gaining |g| Δt on the way, moves at most cfl r0:
+    // step's top speed v (fluid or moving solid), gaining |g| Δt on the way, moves at most cfl r0:
     // (v + g Δt) Δt = cfl r0, so Δt = 2 cfl r0 / (v + √(v² + 4 g cfl r0)). Speed alone
     // (cfl r0 / v) would let a fluid at rest take the largest step, and a column falls g Δt²,
     // 2.5 r0 in 50 ms at r0 = 0.01 m: through its floor's wall in the first step.

@@ -122,6 +122,10 @@ class BackendSimulation final : public Simulation {
         report_.diverged = diverged;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
         report_.solid_max_speed = std::sqrt(double(solid_motion.max_speed2));
+        // The next CFL step bounds every moving particle's travel, a solid's as well as the
+        // fluid's: a solid crossing resting fluid must not jump more than cfl r0 into it. (Its
+        // IBPs' speed stands for its SBPs' and GPs', which are interpolated from them.)
+        last_max_speed_ = std::max(report_.max_speed, report_.solid_max_speed);
     }
 
     const StepReport& last_report() const override { return report_; }
@@ -213,7 +217,6 @@ class BackendSimulation final : public Simulation {
             report_.stage_ms.push_back(stage_ms[stage]);
             report_.total_ms += stage_ms[stage];
         }
-        last_max_speed_ = report_.max_speed;
     }
 
     void report_non_finite(std::uint32_t index, const char* what = "fluid particle") const {

@@ -225,6 +225,22 @@ TEST_CASE("CFL time steps follow the last step's largest speed and gravity, capp
         const SimulationSetup setup = free_block_cfl({0, 0, 0});
         for (const StepReport& r : cfl_steps(setup, 3)) CHECK(r.dt == double(setup.params.solver.dt));
     }
+    SUBCASE("a solid moving past resting fluid bounds the step as fluid at its speed would") {
+        // Its particles must not cross more than cfl r0 of the fluid in a step either. A rigid cube
+        // at 2 m/s (no gravity, away from the fluid and the domain's faces) keeps its speed, so
+        // every step is cfl r0 / (2 m/s) = 0.004 s, not the largest step of 0.01 s that the
+        // fluid at rest alone would allow.
+        SimulationSetup setup = free_block_cfl({0, 0, 0});
+        SolidSetup cube;
+        cube.name = "cube";
+        cube.kind = SolidKind::kRigid;
+        test::add_box_solid(setup, Vec3d{0.1, 0.1, 0.1}, Vec3d{0.75, 0.4, 0.4}, cube, Vec3{2, 0, 0});
+        for (const StepReport& r : cfl_steps(setup, 4)) {
+            CHECK(r.max_speed < 1e-4);  // the block's edges settle by micrometres per second
+            CHECK(r.solid_max_speed == doctest::Approx(2.0).epsilon(1e-4));
+            CHECK(r.dt == doctest::Approx(cfl_r0(setup.params) / 2.0).epsilon(1e-4).scale(0));
+        }
+    }
     SUBCASE("at a huge speed the step is floored at min(dt_min, dt)") {
         // 1e4 m/s: cfl r0 / v = 8e-7 s, below dt_min = 1e-6 s.
         const SimulationSetup fast = free_block_cfl({0, 1e4f, 0});
