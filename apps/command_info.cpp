@@ -8,6 +8,7 @@
 #include "apps/scene_builder.hpp"
 #include "backend/backend_registry.hpp"
 #include "backend/errors.hpp"
+#include "sampling/wall_gap.hpp"
 
 namespace mw {
 
@@ -42,6 +43,9 @@ int command_info(int argc, char** argv) {
     const double bytes_per_particle = counts.total() ? double(bytes) / double(counts.total()) : 0.0;
     const SolverParams& solver = scene.params.solver;
     const bool cfl = solver.dt_mode == TimeStepMode::kCfl;
+    const Real wall_gap = scene.walls ? rest_density_wall_gap(scene.params.fluid.spacing, scene.params.fluid.support_radius,
+                                                              scene.boundary_spacing(), scene.boundary_layers)
+                                      : Real(0);
     const long frames = scene.writes_vtu() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
 
     if (flag_option(args, "json")) {
@@ -53,6 +57,7 @@ int command_info(int argc, char** argv) {
         p["total"] = counts.total();
         j["particles"] = p;
         j["fluid_carved"] = carved_fluid;
+        if (scene.walls) j["wall_gap_m"] = wall_gap;  // the first wall layer's distance outside the faces
         j["backend"] = backend;
         j["device_bytes"] = bytes;
         j["bytes_per_particle"] = bytes_per_particle;
@@ -99,9 +104,13 @@ int command_info(int argc, char** argv) {
                     double(solver.dt), static_cast<long>(std::ceil(scene.end_time / solver.dt - 1e-9)), scene.end_time,
                     stopping_rule, solver.min_iterations, solver.max_iterations);
     std::printf("run         to t=%g s; %ld frames (%g per simulated second)\n", scene.end_time, frames, scene.fps);
-    std::printf("boundary    %s, %d layer(s) at %g m; %zu static box(es)\n",
-                scene.walls ? "domain walls" : "no domain walls", scene.boundary_layers,
-                double(scene.boundary_spacing()), scene.static_boxes.size());
+    if (scene.walls)
+        std::printf("boundary    domain walls, %d layer(s) at %g m, the first %.3g r0 outside the faces (where fluid "
+                    "next to a face starts at rest density for h %.3g r0); %zu static box(es)\n",
+                    scene.boundary_layers, double(scene.boundary_spacing()), double(wall_gap / f.spacing),
+                    double(f.support_radius / f.spacing), scene.static_boxes.size());
+    else
+        std::printf("boundary    no domain walls; %zu static box(es)\n", scene.static_boxes.size());
     return 0;
 }
 

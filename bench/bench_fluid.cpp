@@ -21,6 +21,7 @@
 #include "apps/scene_builder.hpp"
 #include "backend/backend_registry.hpp"
 #include "sampling/box_particles.hpp"
+#include "sampling/wall_gap.hpp"
 
 using namespace mw;
 
@@ -110,7 +111,8 @@ SimulationSetup dam_break(long target, CellOrdering ordering) {
         s.type.push_back(kFluid);
     }
     s.params.domain_walls = true;
-    for (const Vec3& p : sample_container_walls(s.params.domain_min, s.params.domain_max, r0 / 2, 1, kWallGap * r0)) {
+    const Real gap = rest_density_wall_gap(r0, s.params.fluid.support_radius, r0 / 2, 1);
+    for (const Vec3& p : sample_container_walls(s.params.domain_min, s.params.domain_max, r0 / 2, 1, gap)) {
         s.position.push_back(p);
         s.type.push_back(kStaticBoundary);
     }

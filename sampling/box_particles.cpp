@@ -51,7 +51,7 @@ std::vector<Vec3> fill_box_lattice(Vec3 lo, Vec3 hi, Real spacing) {
 std::vector<Vec3> sample_container_walls(Vec3 lo, Vec3 hi, Real spacing, int layers, Real gap) {
     check_box(lo, hi, spacing, "domain walls");
     if (layers < 1) throw InputError("domain walls: layers must be at least 1");
-    if (gap < 0) gap = kWallGap * 2 * spacing;
+    if (!(gap >= 0)) throw InputError("domain walls: the gap outside the faces must be >= 0");
     std::vector<Vec3> points;
     for (int layer = 0; layer < layers; ++layer) {
         const Real d = gap + layer * spacing;

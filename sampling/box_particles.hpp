@@ -14,12 +14,10 @@ std::vector<Vec3> fill_box_lattice(Vec3 lo, Vec3 hi, Real spacing);
 // Boundary particles lining a container [lo, hi]: the first layer `gap` outside the faces,
 // further layers `spacing` apart beyond it. The gap matters: with a single Akinci layer, a fluid
 // layer half a fluid spacing r0 from the wall has 55% too much density (cubic spline, h = 2 r0),
-// one r0 away 6% too much, and 1.1 r0 away the rest density (computed for a lattice against a
-// plane sampled at r0/2 or r0). Fluid blocks start r0/2 inside the faces, so the first wall layer
-// belongs kWallGap r0 outside them: the fluid then starts at rest. A negative gap means
-// kWallGap times twice the boundary spacing (the default boundary spacing is r0/2).
-constexpr Real kWallGap = Real(0.6);
-std::vector<Vec3> sample_container_walls(Vec3 lo, Vec3 hi, Real spacing, int layers, Real gap = -1);
+// one r0 away 6% too much, and 1.1 r0 away the rest density. Fluid blocks start r0/2 inside the
+// faces, so the gap that lets them start at rest is rest_density_wall_gap() (wall_gap.hpp):
+// 0.6 r0 for h = 2 r0 and one layer at r0/2, more for a wider kernel, less for more layers.
+std::vector<Vec3> sample_container_walls(Vec3 lo, Vec3 hi, Real spacing, int layers, Real gap);
 
 // Boundary particles of a solid static box [lo, hi]: the first layer on its faces, further layers
 // `spacing` apart inside it.

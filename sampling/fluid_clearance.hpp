@@ -1,6 +1,6 @@
 // How close fluid may start to a solid: the clearance set-up keeps between a fluid lattice and
 // the boundary particles of static boxes and objects (the domain walls keep theirs through
-// kWallGap, in box_particles.hpp).
+// their gap outside the faces, wall_gap.hpp).
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -33,10 +33,10 @@ TEST_CASE("dam break surge front follows Martin & Moyce") {
         while (sim->time() * time_scale < T[k]) sim->step();
         sim->download(p);
         double front = 0;
-        // Fluid centres beyond the walls' particle layer (kWallGap r0 outside the domain faces): a
-        // leak, long before such a particle would count as lost (beyond the grid).
+        // Fluid centres beyond the walls' particle layer (outside the domain faces): a leak, long
+        // before such a particle would count as lost (beyond the grid).
         long crossed_a_wall = 0;
-        const Real wall = kWallGap * r0;
+        const Real wall = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1);
         for (std::size_t i = 0; i < p.position.size(); ++i) {
             if (p.type[i] != kFluid) continue;
             const Vec3 x = p.position[i];

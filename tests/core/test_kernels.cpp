@@ -287,14 +287,15 @@ TEST_CASE("viscosity (Eq. 4) on a lattice: the discrete Laplacian of a quadratic
 TEST_CASE("wall viscosity (Eq. 8) brakes fluid sliding along a wall, tangentially only") {
     const Real r0 = 0.02f, U = 1.5f, mu_wall = 0.2f;
     const FluidConstants c = viscosity_constants(r0, 0.01f, mu_wall);
-    // As the scenes build it: fluid r0/2 above the face y = 0, one wall layer kWallGap r0 below it at
-    // spacing r0/2, reaching h beyond the fluid's sides.
+    // As the scenes build it: fluid r0/2 above the face y = 0, one wall layer below it at the
+    // scenes' gap (wall_gap.hpp) and spacing r0/2, reaching h beyond the fluid's sides.
+    const Real gap = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1);
     std::vector<Vec3> fluid, walls;
     for (int k = -4; k <= 4; ++k)
         for (int j = 0; j < 6; ++j)
             for (int i = -4; i <= 4; ++i) fluid.push_back(Vec3{i * r0, (j + Real(0.5)) * r0, k * r0});
     for (int k = -16; k <= 16; ++k)
-        for (int i = -16; i <= 16; ++i) walls.push_back(Vec3{i * r0 / 2, -kWallGap * r0, k * r0 / 2});
+        for (int i = -16; i <= 16; ++i) walls.push_back(Vec3{i * r0 / 2, -gap, k * r0 / 2});
     const std::vector<Vec3> velocity(fluid.size(), Vec3{U, 0, 0});
     const ViscosityRun run = run_viscosity(fluid, velocity, walls, c);
 

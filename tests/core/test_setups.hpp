@@ -16,19 +16,20 @@
 #include "sampling/box_particles.hpp"
 #include "sampling/kdtree.hpp"
 #include "sampling/procedural_meshes.hpp"
+#include "sampling/wall_gap.hpp"
 
 namespace mw::test {
 
 // A box of fluid [block_lo, block_hi] in a domain [lo, hi] lined with Akinci walls at spacing r0/2,
-// the first layer kWallGap r0 outside the faces (the fluid starts at rest density); `walls` false
-// leaves the domain open.
+// the first layer rest_density_wall_gap() outside the faces (the fluid starts at rest density); `walls` false
+// leaves the domain open. The kernel's support radius is `support_in_r0` r0.
 inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_hi, Real r0, Real dt,
-                                    bool walls = true) {
+                                    bool walls = true, Real support_in_r0 = 2) {
     SimulationSetup setup;
     setup.params.domain_min = lo;
     setup.params.domain_max = hi;
     setup.params.fluid.spacing = r0;
-    setup.params.fluid.support_radius = 2 * r0;
+    setup.params.fluid.support_radius = support_in_r0 * r0;
     setup.params.fluid.rest_density = 1000;
     setup.params.solver.dt = dt;
     for (const Vec3& p : fill_box_lattice(block_lo, block_hi, r0)) {
@@ -37,7 +38,8 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
     }
     setup.params.domain_walls = walls;
     if (walls) {
-        for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, kWallGap * r0)) {
+        const Real gap = rest_density_wall_gap(r0, setup.params.fluid.support_radius, r0 / 2, 1);
+        for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, gap)) {
             setup.position.push_back(p);
             setup.type.push_back(kStaticBoundary);
         }

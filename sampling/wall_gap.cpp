@@ -1,0 +1,71 @@
+#include "sampling/wall_gap.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "algorithms/sph_kernels.hpp"
+#include "backend/errors.hpp"
+
+namespace mw {
+
+namespace {
+// Σ W over an infinite square grid of `spacing` in a plane at distance `dz`, one grid point
+// straight across (the grid's lateral offset changes the result by less than 1e-4 of ρ0 for the
+// spacings allowed, r0/2 and finer being the common case).
+double sheet_sum(const SphKernel& kernel, double spacing, double dz) {
+    const int reach = static_cast<int>(std::ceil(double(kernel.h) / spacing)) + 1;
+    double sum = 0;
+    for (int j = -reach; j <= reach; ++j)
+        for (int i = -reach; i <= reach; ++i) {
+            const double r = std::sqrt((i * spacing) * (i * spacing) + (j * spacing) * (j * spacing) + dz * dz);
+            sum += kernel.W(Real(r));
+        }
+    return sum;
+}
+}  // namespace
+
+Real rest_density_wall_gap(Real r0_in, Real h_in, Real boundary_spacing_in, int layers) {
+    const double r0 = r0_in, h = h_in, s = boundary_spacing_in;
+    if (!(r0 > 0) || !(h > r0) || !(s > 0) || layers < 1)
+        throw InputError("wall gap: need spacing > 0, support radius > spacing, boundary spacing > 0, layers >= 1");
+    const SphKernel kernel = SphKernel::with_support(Real(h));
+    const int reach = static_cast<int>(std::ceil(h / r0)) + 1;
+
+    // The fluid mass makes a full lattice the rest density: ρ0 = m Σ W (ρ0 cancels below, so
+    // densities are in units of ρ0 and m = 1 / Σ W).
+    double full = 0, half = 0;  // half: the first layer's own half-lattice, r0/2 above the face
+    for (int k = -reach; k <= reach; ++k)
+        for (int j = -reach; j <= reach; ++j)
+            for (int i = -reach; i <= reach; ++i) {
+                const double w = kernel.W(Real(r0 * std::sqrt(double(i * i + j * j + k * k))));
+                full += w;
+                if (k >= 0) half += w;  // fluid layers at 0.5 r0 + k r0, the particle's own at k = 0
+            }
+    const double fluid_part = half / full;
+
+    // Each wall layer's Akinci volume, from every layer's sheet (independent of the gap).
+    std::vector<double> volume(layers);
+    for (int a = 0; a < layers; ++a) {
+        double sum = 0;
+        for (int b = 0; b < layers; ++b) sum += sheet_sum(kernel, s, (b - a) * s);
+        volume[a] = 1 / sum;
+    }
+    // The first fluid layer's density (units of ρ0) with the first wall layer `gap` outside the face.
+    auto density = [&](double gap) {
+        double wall = 0;
+        for (int a = 0; a < layers; ++a) wall += volume[a] * sheet_sum(kernel, s, 0.5 * r0 + gap + a * s);
+        return fluid_part + wall;
+    };
+    double lo = 0, hi = h + r0;  // at hi no wall particle is within h: the density is the half-lattice's
+    if (!(density(lo) > 1) || !(density(hi) < 1))
+        throw InputError("wall gap: no placement of the domain walls gives the fluid its rest density (h = " +
+                         std::to_string(h) + " m, r0 = " + std::to_string(r0) + " m)");
+    for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (density(mid) > 1 ? lo : hi) = mid;
+    }
+    return Real(0.5 * (lo + hi));
+}
+
+}  // namespace mw
