@@ -31,7 +31,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid = nullptr);
 // Removes the fluid particles that solids occupy (points_solids_occupy, with clearance
 // kFluidClearance r0 in scenes): those inside one of `boxes` and those closer than `clearance` to
 // a static, surface or inner boundary particle at index >= first_solid (the domain walls, placed
-// before first_solid, sit 0.35–1.23 r0 outside the domain, wall_gap.hpp, and never come that
+// before first_solid, sit 0.31–1.23 r0 outside the domain, wall_gap.hpp, and never come that
 // close). Indices in setup.solids are renumbered. Returns, for every particle before the call,
 // whether it was removed.
 std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,

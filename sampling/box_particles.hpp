@@ -16,7 +16,8 @@ std::vector<Vec3> fill_box_lattice(Vec3 lo, Vec3 hi, Real spacing);
 // layer half a fluid spacing r0 from the wall has 55% too much density (cubic spline, h = 2 r0),
 // one r0 away 6% too much, and 1.1 r0 away the rest density. Fluid blocks start r0/2 inside the
 // faces, so the gap that lets them start at rest is rest_density_wall_gap() (wall_gap.hpp):
-// 0.6 r0 for h = 2 r0 and one layer at r0/2, more for a wider kernel, less for more layers.
+// 0.6 r0 for h = 2 r0 and one layer at r0/2, more for a wider kernel (from h = 1.5 r0 up), less
+// for more layers.
 std::vector<Vec3> sample_container_walls(Vec3 lo, Vec3 hi, Real spacing, int layers, Real gap);
 
 // Boundary particles of a solid static box [lo, hi]: the first layer on its faces, further layers

@@ -102,11 +102,12 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
 
 // The paper's kernel width, h = 2.5 r0 (its Table 1: r0 0.02 m, h 0.05 m). Until the twelfth
 // session the domain walls' first layer sat 0.6 r0 outside the faces whatever h was, which is
-// right for h = 2 r0 only: at 2.5 r0 the fluid next to a face started 8% over rest density, and
+// right for h = 2 r0 only: at 2.5 r0 the fluid next to a face started 9% over rest density, and
 // this column diverged in its first step and lost 1,507 of its 2,000 particles within 1 s, at
 // Δt = 1 ms as at 0.5 ms. The walls are now placed for the kernel (sampling/wall_gap.hpp).
-// (At Δt = 2 ms PCISPH's iteration still diverges at this width, after about 18 steps: the wider
-// kernel lowers the step PCISPH holds; docs/solver.md.)
+// (At Δt = 2 ms with the scenes' peak bound eta_max = 0.05, which this set-up does not use,
+// PCISPH's iteration still diverges at this width after 15-18 steps: the wider kernel lowers the
+// step PCISPH holds; docs/solver.md.)
 TEST_CASE("hydrostatic column at the paper's support radius h = 2.5 r0 stays at rest") {
     // 0.28 m wide: the profile leaves out 2 h along every wall, 0.1 m here.
     const Real r0 = 0.02f, height = 0.4f, width = 0.28f;
