@@ -35,6 +35,8 @@ MW_INLINE Vec3& operator*=(Vec3& a, Real s) {
     a.z *= s;
     return a;
 }
+// Component-wise product (a reflection's scale applied to a point or a velocity).
+MW_INLINE Vec3 hadamard(Vec3 a, Vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
 MW_INLINE Real dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 MW_INLINE Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 MW_INLINE Real norm2(Vec3 a) { return dot(a, a); }

@@ -20,8 +20,6 @@
 
 namespace mw {
 
-MW_INLINE Vec3 hadamard(Vec3 a, Vec3 b) { return Vec3{a.x * b.x, a.y * b.y, a.z * b.z}; }
-
 struct WallMirrors {
     Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // the domain's faces
     unsigned faces = 0;             // bit 2a: the face at lo on axis a is a wall; bit 2a+1: at hi

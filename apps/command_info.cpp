@@ -8,7 +8,6 @@
 #include "apps/scene_builder.hpp"
 #include "backend/backend_registry.hpp"
 #include "backend/errors.hpp"
-#include "sampling/wall_gap.hpp"
 
 namespace mw {
 
@@ -43,9 +42,7 @@ int command_info(int argc, char** argv) {
     const double bytes_per_particle = counts.total() ? double(bytes) / double(counts.total()) : 0.0;
     const SolverParams& solver = scene.params.solver;
     const bool cfl = solver.dt_mode == TimeStepMode::kCfl;
-    const Real wall_gap = scene.walls ? rest_density_wall_gap(scene.params.fluid.spacing, scene.params.fluid.support_radius,
-                                                              scene.boundary_spacing(), scene.boundary_layers)
-                                      : Real(0);
+    const Real wall_gap = scene.walls ? scene.wall_gap() : Real(0);
     const long frames = scene.writes_vtu() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
 
     if (flag_option(args, "json")) {

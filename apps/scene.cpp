@@ -14,6 +14,7 @@
 #include <unordered_set>
 
 #include "backend/errors.hpp"
+#include "sampling/wall_gap.hpp"
 
 namespace mw {
 
@@ -690,6 +691,11 @@ std::string read_file(const std::string& path) {
 }
 
 }  // namespace
+
+Real Scene::wall_gap() const {
+    return rest_density_wall_gap(params.fluid.spacing, params.fluid.support_radius, boundary_spacing(),
+                                 boundary_layers);
+}
 
 bool Scene::writes_vtu() const {
     for (const auto& f : formats)

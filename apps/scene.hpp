@@ -64,6 +64,8 @@ struct Scene {
     SceneJson resolved;  // every key with its value, defaults filled in, overrides applied
 
     Real boundary_spacing() const { return boundary_spacing_factor * params.fluid.spacing; }
+    // How far outside the domain faces the walls' first layer goes (sampling/wall_gap.hpp), m.
+    Real wall_gap() const;
     bool writes_vtu() const;
 };
 

@@ -11,7 +11,6 @@
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/solid_sample.hpp"
-#include "sampling/wall_gap.hpp"
 
 #include <filesystem>
 
@@ -172,8 +171,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         // The first layer where fluid blocks touching a wall start at rest density (wall_gap.hpp).
         append(setup,
                sample_container_walls(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers,
-                                      rest_density_wall_gap(r0, scene.params.fluid.support_radius, rb,
-                                                            scene.boundary_layers)),
+                                      scene.wall_gap()),
                Vec3{0, 0, 0}, kStaticBoundary, -1);
     const std::size_t first_solid = setup.position.size();
     std::vector<Eigen::AlignedBox3d> boxes;

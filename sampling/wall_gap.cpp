@@ -1,6 +1,7 @@
 #include "sampling/wall_gap.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,12 @@
 namespace mw {
 
 namespace {
+std::string format_length(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.9g", x);
+    return text;
+}
+
 // Σ W over an infinite square grid of `spacing` in a plane at distance `dz`, one grid point
 // straight across. The grid's lateral offset against the fluid changes the first layer's density
 // by less than 1e-4 of ρ0 for spacings up to r0/2 (the default); at a spacing of r0 by up to 0.3%
@@ -60,8 +67,9 @@ Real rest_density_wall_gap(Real r0_in, Real h_in, Real boundary_spacing_in, int 
     };
     double lo = 0, hi = h + r0;  // at hi no wall particle is within h: the density is the half-lattice's
     if (!(density(lo) > 1) || !(density(hi) < 1))
-        throw InputError("wall gap: no placement of the domain walls gives the fluid its rest density (h = " +
-                         std::to_string(h) + " m, r0 = " + std::to_string(r0) + " m)");
+        throw InputError("fluid.support_radius: no placement of the domain walls gives the fluid its rest density "
+                         "with h = " + format_length(h) + " m and fluid.spacing r0 = " + format_length(r0) +
+                         " m; h must exceed r0 by more than rounding");
     for (int it = 0; it < 60; ++it) {
         const double mid = 0.5 * (lo + hi);
         (density(mid) > 1 ? lo : hi) = mid;

@@ -279,6 +279,22 @@ TEST_CASE("static boxes and objects carve the fluid: none is left inside them or
     }
 }
 
+// h a rounding error above r0 passes the scene's range (r0, 4 r0] but leaves no wall placement
+// that gives the fluid its rest density (sampling/wall_gap.hpp): refused at set-up, naming the key.
+TEST_CASE("a support radius within rounding of the spacing is refused, naming the key") {
+    const Scene s = parse_scene_text(tiny_scene_text(), "t", {"fluid.support_radius=0.02000001"});
+    try {
+        build_setup(s);
+        FAIL("build_setup accepted h = r0 (1 + 5e-7)");
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        CAPTURE(message);
+        CHECK(contains(message, "fluid.support_radius"));
+        CHECK(contains(message, "fluid.spacing"));
+        CHECK(message.find('\n') == std::string::npos);
+    }
+}
+
 TEST_CASE("a scene too large to build is refused before allocating") {
     const Scene s = parse_scene_text(tiny_scene_text(), "t", {"domain.max=[1000,1000,1000]", "fluid.spacing=0.001"});
     CHECK_THROWS_AS(build_setup(s), InputError);

@@ -55,7 +55,7 @@ TEST_CASE("kernel gradient is antisymmetric, points inward and matches finite di
     CHECK(kernel.W(Real(0.1)) == 0);
 }
 
-TEST_CASE("the branch-free forms the neighbour sums use equal W, grad W and the viscosity Laplacian, and vanish out of range") {
+TEST_CASE("the branch-free forms of W, grad W and the viscosity Laplacian equal them, and vanish out of range") {
     const Real h = Real(0.1);
     const CubicSpline3D kernel = CubicSpline3D::with_support(h);
     double worst_w = 0, worst_grad = 0, worst_laplacian = 0;
@@ -69,8 +69,8 @@ TEST_CASE("the branch-free forms the neighbour sums use equal W, grad W and the 
         worst_w = std::max(worst_w, double(std::fabs(kernel.W_r2(r2) - kernel.W(d))) / double(kernel.W(0)));
         worst_grad = std::max(worst_grad, double(norm(kernel.grad_W_r2(r, r2) - kernel.grad_W(r, d))) /
                                               double(kernel.grad_scale));
-        worst_laplacian = std::max(worst_laplacian, double(std::fabs(kernel.laplacian_visc_r2(r2) - kernel.laplacian_visc(d))) /
-                                                        double(kernel.laplacian_visc(0)));
+        const double laplacian_error = std::fabs(kernel.laplacian_visc_r2(r2) - kernel.laplacian_visc(d));
+        worst_laplacian = std::max(worst_laplacian, laplacian_error / double(kernel.laplacian_visc(0)));
         if (d >= h) {
             CHECK(kernel.W_r2(r2) == 0);
             CHECK(norm(kernel.grad_W_r2(r, r2)) == 0);
@@ -435,7 +435,8 @@ TEST_CASE("viscosity next to a free-slip wall: the fluid's mirror images stand i
         for (int k = 0; k < 8; ++k)
             for (int j = 0; j < 8; ++j)
                 for (int i = 0; i < 8; ++i)
-                    fluid.push_back(Vec3{x0 + (i + Real(0.5)) * r0, y0 + (j + Real(0.5)) * r0, z1 - (k + Real(0.5)) * r0});
+                    fluid.push_back(
+                        Vec3{x0 + (i + Real(0.5)) * r0, y0 + (j + Real(0.5)) * r0, z1 - (k + Real(0.5)) * r0});
         // Distances from the three faces; checked: 2 r0 clear of the lattice's far sides.
         auto depth = [&](Vec3 x) { return Vec3{x.x - x0, x.y - y0, z1 - x.z}; };
         auto checked = [&](Vec3 x) {
@@ -489,7 +490,8 @@ TEST_CASE("viscosity next to a free-slip wall: the mirror images are symmetric a
     // between h and h + e from that face, which does not itself enumerate the face).
     std::vector<Vec3> fluid;
     std::uniform_real_distribution<float> coordinate(-0.1f * r0, 8 * r0);
-    for (int k = 0; k < 512; ++k) fluid.push_back(corner + Vec3{coordinate(random), coordinate(random), coordinate(random)});
+    for (int k = 0; k < 512; ++k)
+        fluid.push_back(corner + Vec3{coordinate(random), coordinate(random), coordinate(random)});
     // And one such pair for certain: i 0.1 r0 past the face x = corner.x, j 2.05 r0 inside it (so
     // beyond h from the face, and 2.15 r0 from i), whose image is 1.95 r0 from i. They are not
     // neighbours, so neither may meet the other's image.

@@ -21,8 +21,8 @@
 namespace mw::test {
 
 // A box of fluid [block_lo, block_hi] in a domain [lo, hi] lined with Akinci walls at spacing r0/2,
-// the first layer rest_density_wall_gap() outside the faces (the fluid starts at rest density); `walls` false
-// leaves the domain open. The kernel's support radius is `support_in_r0` r0.
+// the first layer rest_density_wall_gap() outside the faces (the fluid starts at rest density);
+// `walls` false leaves the domain open. The kernel's support radius is `support_in_r0` r0.
 inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_hi, Real r0, Real dt,
                                     bool walls = true, Real support_in_r0 = 2) {
     SimulationSetup setup;
