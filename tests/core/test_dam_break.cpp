@@ -1,5 +1,5 @@
 // Dam break against Martin & Moyce (1952), n² = 2: a column a wide and 2a high collapses on a dry
-// floor. Two of their measurements, from the same experiments (a = 2¼ in, their Tables 2 and 6;
+// floor. Two of their measurements on the same column (a = 2¼ in, their Tables 2 and 6;
 // METHOD.md gives the front's; the heights as transcribed in TormodLandet/Ocellaris,
 // scripts/plot_dam_break.py, beside the same front table), compared with one run at r0 = a/20,
 // free-slip walls, no tuning:
@@ -11,7 +11,7 @@
 //    measured: within 1.2% at T = 0.41, up to 20% ahead around T = 1.2, 11% at T = 2.51, and
 //    at the experiment's speed from T = 1.8 on. Asserted: never more than 10% behind or 25% ahead,
 //    the early advance at T = 0.41 and the late speed dZ/dT.
-// Both measurements share the clock, so the front's lead is not a late start of the experiment:
+// If both tables share the experiment's clock, the front's lead is not a late start of it:
 // the heights fit the table best with no shift of the clock (0.015 in τ), and the shift that fits
 // the front best (0.265 in T) puts the heights up to 8.3% off. The lead lies in the thin toe ahead
 // of the column (docs/solver.md).
