@@ -106,11 +106,13 @@ if (( size + tree > 56 * 1048576 )); then echo "gpu_bundle: WARNING: close to th
 
 cat <<'EOF'
 
-== GPU session: the run tool calls (timeout_s 600 each; every stage unpacks the bundle first, so
-   each call also works on a fresh machine). Results come back as gpu-STAGE.tar.gz + gpu-STAGE.log.
- 1. command: bash bench/gpu_session.sh unpack test       carry: ["gpu-bundle"]
- 2. command: bash bench/gpu_session.sh sanitize ncu      carry: ["gpu-bundle"]
- 3. command: bash bench/gpu_session.sh bench             carry: ["gpu-bundle"]
- 4. only if gpu-ncu.log of call 2 says it was skipped or cut short (sanitize ran long):
-    command: bash bench/gpu_session.sh ncu               carry: ["gpu-bundle"]
+== GPU session: the run tool calls (timeout_s 600 each, carry ["gpu-bundle"]; every stage unpacks the
+   bundle first, so each call also works on a fresh machine). Results come back as
+   gpu-STAGE.tar.gz + gpu-STAGE.log. A session has 15 minutes of device time, the machine's start
+   included, so the tests and the benchmark go in the first call:
+ 1. command: bash bench/gpu_session.sh unpack test bench
+ 2. at once (the machine stays warm 30 s), if the device tool's status shows 6 minutes left:
+    command: bash bench/gpu_session.sh sanitize ncu
+   Where the tool gives a call less than 600 s (little time left), put GPU_DEADLINE_S=<limit - 60>
+   before the command.
 EOF

@@ -43,11 +43,15 @@ if [[ -n "$gpu" ]] && want cuda; then
   echo "## Fluid, CUDA" >> "$out"
   "$build/bench_fluid" --backend cuda --large --out "$out" "$@"
 fi
+# bench_lsm times every backend available, also in a GPU session: its OpenMP rows on that
+# machine's cores stand beside the CUDA rows of the same run (a few seconds in all).
 if [[ -x "$build/bench_lsm" ]]; then
   echo "## LSM (elastic cubes, w = 2, and rigid cubes; every backend available)" >> "$out"
   OMP_NUM_THREADS=$threads "$build/bench_lsm" >> "$out" || echo "bench_lsm failed" >> "$out"
 fi
-if [[ -x "$build/bench_sampling" ]]; then
+# Sampling runs on the host only: a GPU session (BENCH_BACKENDS without openmp) leaves it to the
+# development machine's reports.
+if [[ -x "$build/bench_sampling" ]] && want openmp; then
   echo "## Sampling (bunny, 0.5 m)" >> "$out"
   "$build/bench_sampling" --threads "$threads" --out "$out.sampling.tmp" && cat "$out.sampling.tmp" >> "$out" && rm -f "$out.sampling.tmp"
 fi

@@ -22,18 +22,109 @@ inline std::vector<int> random_values(std::size_t n, unsigned seed) {
     return values;
 }
 
+// Sizes from empty through one element and a single block (a reduction's one-tile path on a GPU,
+// which the small scenes take) to many blocks with a partial tail.
+constexpr std::size_t kReductionSizes[] = {0, 1, 7, 1000, kPrimitiveCount};
+
 inline void check_reductions() {
-    const std::vector<int> values = random_values(kPrimitiveCount, 7);
-    DeviceArray<int> data;
+    for (const std::size_t n : kReductionSizes) {
+        CAPTURE(n);
+        const std::vector<int> values = random_values(n, 7);
+        DeviceArray<int> data;
+        data.upload(values);
+        const View<const int> d = data.cview();
+        CHECK(transform_reduce("sum", n, 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
+              std::accumulate(values.begin(), values.end(), 0L));
+        CHECK(transform_reduce("min", n, 1 << 30, MinOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
+              (n ? *std::min_element(values.begin(), values.end()) : 1 << 30));
+        CHECK(transform_reduce("max", n, -(1 << 30), MaxOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
+              (n ? *std::max_element(values.begin(), values.end()) : -(1 << 30)));
+    }
+}
+
+// A reduction over a struct of mixed members, as the solver's are (a double sum, a float maximum,
+// the lowest index of a planted bad value): every member must come back, at every size.
+struct MixedSummary {
+    double sum = 0;
+    float max = 0;
+    std::uint32_t first_marked = 0xffffffffu;
+};
+struct MixedSummaryOp {
+    MW_INLINE MixedSummary operator()(const MixedSummary& a, const MixedSummary& b) const {
+        return MixedSummary{a.sum + b.sum, a.max < b.max ? b.max : a.max,
+                            a.first_marked < b.first_marked ? a.first_marked : b.first_marked};
+    }
+};
+inline void check_struct_reductions() {
+    for (const std::size_t n : kReductionSizes) {
+        CAPTURE(n);
+        const std::vector<int> values = random_values(n, 19);
+        DeviceArray<int> data;
+        data.upload(values);
+        const View<const int> d = data.cview();
+        // Values of -500 and -499 are "marked"; the lowest such index must win.
+        const MixedSummary got = transform_reduce(
+            "mixed summary", n, MixedSummary{}, MixedSummaryOp{}, [=] MW_HD(std::size_t i) {
+                const int v = d[i];
+                return MixedSummary{0.5 * v, float(v > 0 ? v : 0),
+                                    v <= -499 ? static_cast<std::uint32_t>(i) : 0xffffffffu};
+            });
+        double sum = 0;
+        float max = 0;
+        std::uint32_t first = 0xffffffffu;
+        for (std::size_t i = 0; i < n; ++i) {
+            sum += 0.5 * values[i];
+            max = std::max(max, float(std::max(values[i], 0)));
+            if (values[i] <= -499 && first == 0xffffffffu) first = static_cast<std::uint32_t>(i);
+        }
+        CHECK(got.sum == sum);  // halves of integers: every partial sum is exact in double
+        CHECK(got.max == max);
+        CHECK(got.first_marked == first);
+    }
+}
+
+// A scan and a reduction back to back, twice: on a GPU both return their result through the same
+// small pinned host buffer.
+inline void check_scan_then_reduce() {
+    const std::vector<int> values = random_values(kPrimitiveCount, 23);
+    DeviceArray<int> data, scanned(values.size());
     data.upload(values);
     const View<const int> d = data.cview();
-    const std::size_t n = values.size();
-    CHECK(transform_reduce("sum", n, 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
-          std::accumulate(values.begin(), values.end(), 0L));
-    CHECK(transform_reduce("min", n, 1 << 30, MinOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
-          *std::min_element(values.begin(), values.end()));
-    CHECK(transform_reduce("max", n, -(1 << 30), MaxOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
-          *std::max_element(values.begin(), values.end()));
+    const int total = std::accumulate(values.begin(), values.end(), 0);
+    const long total_long = std::accumulate(values.begin(), values.end(), 0L);
+    for (int round = 0; round < 2; ++round) {
+        CAPTURE(round);
+        CHECK(exclusive_scan("scan", data.cview(), scanned.view()) == total);
+        CHECK(transform_reduce("sum", values.size(), 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
+              total_long);
+    }
+    std::vector<int> expected(values.size());
+    std::exclusive_scan(values.begin(), values.end(), expected.begin(), 0);
+    CHECK(scanned.to_host() == expected);
+}
+
+// Stage timers: a timed stage reads a positive time, a stage not started reads 0, and read() starts
+// the next interval from 0 (the step's stats rely on all three).
+inline void check_stage_timers() {
+    const std::vector<int> values = random_values(kPrimitiveCount, 29);
+    DeviceArray<int> data, out(values.size());
+    data.upload(values);
+    const View<const int> d = data.cview();
+    const View<int> o = out.view();
+    StageTimers timers(2);
+    timers.start(0);
+    for (int pass = 0; pass < 20; ++pass)
+        parallel_for("timed work", values.size(), [=] MW_HD(std::size_t i) { o[i] = d[i] * 3 + pass; });
+    timers.stop(0);
+    double ms[2] = {-1, -1};
+    timers.read(ms);
+    CHECK(ms[0] > 0);
+    CHECK(ms[0] < 10000);
+    CHECK(ms[1] == 0);
+    timers.read(ms);
+    CHECK(ms[0] == 0);
+    CHECK(ms[1] == 0);
+    CHECK(out.to_host()[5] == values[5] * 3 + 19);  // the timed work was done
 }
 
 inline void check_exclusive_scan() {

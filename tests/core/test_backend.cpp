@@ -14,4 +14,10 @@ TEST_CASE("reductions, scan, sort and atomics agree with sequential answers") {
     test::check_atomics();
 }
 
+TEST_CASE("struct reductions, a scan and a reduction back to back, and stage timers") {
+    test::check_struct_reductions();
+    test::check_scan_then_reduce();
+    test::check_stage_timers();
+}
+
 TEST_CASE("memory ledger follows allocations") { test::check_memory_ledger(); }

@@ -2,6 +2,8 @@
 // tests/core/backend_primitives.hpp compiled for the GPU. Built only with the CUDA backend; each
 // case skips with a message where no CUDA device is present (CI).
 #define DOCTEST_CONFIG_IMPLEMENT
+#include <string>
+
 #include "tests/skip.hpp"
 
 #define MW_BACKEND_CUDA
@@ -29,6 +31,29 @@ TEST_CASE("CUDA atomics lose no update") {
 }
 TEST_CASE("CUDA memory ledger follows allocations") {
     if (gpu_present()) mw::test::check_memory_ledger();
+}
+TEST_CASE("CUDA struct reductions, at every size from empty to many blocks") {
+    if (gpu_present()) mw::test::check_struct_reductions();
+}
+TEST_CASE("CUDA scan and reduction back to back (one pinned result buffer)") {
+    if (gpu_present()) mw::test::check_scan_then_reduce();
+}
+TEST_CASE("CUDA stage timers (events)") {
+    if (gpu_present()) mw::test::check_stage_timers();
+}
+// An allocation larger than the device is a DeviceError that says so (the command line adds the
+// scene's estimate to it), and leaves the device usable.
+TEST_CASE("CUDA out of memory is a clear error, and the device stays usable") {
+    if (!gpu_present()) return;
+    const auto free_bytes = static_cast<std::size_t>(mw::device_memory_free());
+    std::string message;
+    try {
+        mw::DeviceArray<char> too_large(2 * free_bytes + (std::size_t(1) << 30));
+    } catch (const mw::DeviceError& e) {
+        message = e.what();
+    }
+    CHECK(message.find("out of GPU memory") != std::string::npos);
+    mw::test::check_reductions();
 }
 
 MW_TEST_MAIN
