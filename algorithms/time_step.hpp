@@ -234,6 +234,8 @@ class BackendSimulation final : public Simulation {
         throw SimulationError(text);
     }
 
+    // First, so that it goes last: the backend frees its shared scratch when no simulation is left.
+    ScratchUser scratch_user_;
     SimulationParams params_;
     FluidConstants fluid_;
     double delta_times_dt2_ = 0;  // δ·Δt², from the prototype lattice

@@ -1,6 +1,7 @@
 // Non-template parts of the OpenMP backend.
 #include <unistd.h>
 
+#include <atomic>
 #include <fstream>
 
 #define MW_BACKEND_OPENMP
@@ -75,6 +76,17 @@ RadixScratch& radix_scratch() {
 std::size_t backend_scratch_bytes() {
     const RadixScratch& s = radix_scratch();
     return (s.keys.capacity() + s.values.capacity()) * sizeof(std::uint32_t) + s.offsets.capacity() * sizeof(std::size_t);
+}
+
+namespace {
+std::atomic<int>& scratch_users() {
+    static std::atomic<int> users{0};
+    return users;
+}
+}  // namespace
+ScratchUser::ScratchUser() { ++scratch_users(); }
+ScratchUser::~ScratchUser() {
+    if (--scratch_users() == 0) radix_scratch() = RadixScratch{};
 }
 
 void sort_pairs(const char* /*name*/, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
