@@ -10,3 +10,4 @@
 #else
 #error "define MW_BACKEND_CUDA or MW_BACKEND_OPENMP before including backend/backend.hpp"
 #endif
+#include "backend/scratch_user.hpp"

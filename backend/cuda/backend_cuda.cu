@@ -1,5 +1,4 @@
 // Non-template parts of the CUDA backend.
-#include <atomic>
 #include <cstdlib>
 
 #define MW_BACKEND_CUDA
@@ -95,17 +94,8 @@ void* cub_workspace(std::size_t bytes) {
 
 std::size_t backend_scratch_bytes() { return cub_workspace_array().bytes(); }
 
-namespace {
-std::atomic<int>& scratch_users() {
-    static std::atomic<int> users{0};
-    return users;
-}
-}  // namespace
-ScratchUser::ScratchUser() { ++scratch_users(); }
 // cudaFree waits for the device, so no kernel still uses the workspace when it goes.
-ScratchUser::~ScratchUser() {
-    if (--scratch_users() == 0) cub_workspace_array().release();
-}
+void release_backend_scratch() { cub_workspace_array().release(); }
 
 void* pinned_scratch(std::size_t bytes) {
     static void* buffer = nullptr;

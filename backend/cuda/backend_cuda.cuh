@@ -194,19 +194,10 @@ void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::u
 // Scratch the backend keeps between calls and that no DeviceArray owner counts: CUB's workspace,
 // shared by every sort, scan and reduction of the process (the radix sort's is the large one,
 // about 8 bytes per sorted item, held with half again as headroom). Grows while a simulation
-// lives; freed with the last one (ScratchUser).
+// lives; release_backend_scratch (called when the last one goes, backend/scratch_user.hpp) frees
+// it.
 std::size_t backend_scratch_bytes();
-
-// Held by every simulation of this backend. When the last one is destroyed the workspace above is
-// freed, so that the next simulation's memory figure is its own and not the largest of the
-// process so far (a benchmark runs cases from 7k to 4M particles in turn).
-class ScratchUser {
-   public:
-    ScratchUser();
-    ~ScratchUser();
-    ScratchUser(const ScratchUser&) = delete;
-    ScratchUser& operator=(const ScratchUser&) = delete;
-};
+void release_backend_scratch();
 
 // Atomics are called from host/device lambdas; only the device path runs on this backend.
 #if defined(__CUDA_ARCH__)

@@ -1,7 +1,6 @@
 // Non-template parts of the OpenMP backend.
 #include <unistd.h>
 
-#include <atomic>
 #include <fstream>
 
 #define MW_BACKEND_OPENMP
@@ -78,16 +77,7 @@ std::size_t backend_scratch_bytes() {
     return (s.keys.capacity() + s.values.capacity()) * sizeof(std::uint32_t) + s.offsets.capacity() * sizeof(std::size_t);
 }
 
-namespace {
-std::atomic<int>& scratch_users() {
-    static std::atomic<int> users{0};
-    return users;
-}
-}  // namespace
-ScratchUser::ScratchUser() { ++scratch_users(); }
-ScratchUser::~ScratchUser() {
-    if (--scratch_users() == 0) radix_scratch() = RadixScratch{};
-}
+void release_backend_scratch() { radix_scratch() = RadixScratch{}; }
 
 void sort_pairs(const char* /*name*/, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
                 View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits) {

@@ -153,19 +153,10 @@ void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::u
 
 // Scratch the backend keeps between calls and that no DeviceArray owner counts: the sort's
 // ping-pong buffers (8 bytes per sorted item) of the calling thread. Grows while a simulation
-// lives; freed with the last one (ScratchUser).
+// lives; release_backend_scratch (called when the last one goes, backend/scratch_user.hpp) frees
+// the calling thread's.
 std::size_t backend_scratch_bytes();
-
-// Held by every simulation of this backend. When the last one is destroyed the scratch above (of
-// the destroying thread) is freed, so that the next simulation's memory figure is its own and not
-// the largest of the process so far (a benchmark runs cases from 7k to 4M particles in turn).
-class ScratchUser {
-   public:
-    ScratchUser();
-    ~ScratchUser();
-    ScratchUser(const ScratchUser&) = delete;
-    ScratchUser& operator=(const ScratchUser&) = delete;
-};
+void release_backend_scratch();
 
 MW_INLINE void atomic_add(int* address, int value) { __atomic_fetch_add(address, value, __ATOMIC_RELAXED); }
 MW_INLINE void atomic_add(unsigned* address, unsigned value) {

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "algorithms/pcisph.hpp"
 #include "backend/backend.hpp"
 
 namespace mw::test {
@@ -42,19 +43,9 @@ inline void check_reductions() {
     }
 }
 
-// A reduction over a struct of mixed members, as the solver's are (a double sum, a float maximum,
-// the lowest index of a planted bad value): every member must come back, at every size.
-struct MixedSummary {
-    double sum = 0;
-    float max = 0;
-    std::uint32_t first_marked = 0xffffffffu;
-};
-struct MixedSummaryOp {
-    MW_INLINE MixedSummary operator()(const MixedSummary& a, const MixedSummary& b) const {
-        return MixedSummary{a.sum + b.sum, a.max < b.max ? b.max : a.max,
-                            a.first_marked < b.first_marked ? a.first_marked : b.first_marked};
-    }
-};
+// The solver's own reductions over structs of mixed members (pcisph.hpp): the density error (a
+// double sum and a Real maximum) and the motion summary (a double sum, a Real maximum and the
+// lowest index of a bad value). Every member must come back, at every size.
 inline void check_struct_reductions() {
     for (const std::size_t n : kReductionSizes) {
         CAPTURE(n);
@@ -62,24 +53,31 @@ inline void check_struct_reductions() {
         DeviceArray<int> data;
         data.upload(values);
         const View<const int> d = data.cview();
-        // Values of -500 and -499 are "marked"; the lowest such index must win.
-        const MixedSummary got = transform_reduce(
-            "mixed summary", n, MixedSummary{}, MixedSummaryOp{}, [=] MW_HD(std::size_t i) {
+        // Values of -500 and -499 are "bad"; the lowest such index must win.
+        const MotionSummary motion =
+            transform_reduce("motion summary", n, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
                 const int v = d[i];
-                return MixedSummary{0.5 * v, float(v > 0 ? v : 0),
-                                    v <= -499 ? static_cast<std::uint32_t>(i) : 0xffffffffu};
+                return MotionSummary{0.5 * v, Real(v > 0 ? v : 0), v <= -499 ? static_cast<std::uint32_t>(i) : 0xffffffffu};
             });
-        double sum = 0;
-        float max = 0;
+        const DensityError density = transform_reduce(
+            "density error", n, DensityError{}, DensityErrorOp{},
+            [=] MW_HD(std::size_t i) { return DensityError{0.25 * d[i], Real(d[i] < 0 ? -d[i] : 0)}; });
+        double sum = 0, quarter_sum = 0;
+        Real max = 0, max_negative = 0;
         std::uint32_t first = 0xffffffffu;
         for (std::size_t i = 0; i < n; ++i) {
             sum += 0.5 * values[i];
-            max = std::max(max, float(std::max(values[i], 0)));
+            quarter_sum += 0.25 * values[i];
+            max = std::max(max, Real(std::max(values[i], 0)));
+            max_negative = std::max(max_negative, Real(std::max(-values[i], 0)));
             if (values[i] <= -499 && first == 0xffffffffu) first = static_cast<std::uint32_t>(i);
         }
-        CHECK(got.sum == sum);  // halves of integers: every partial sum is exact in double
-        CHECK(got.max == max);
-        CHECK(got.first_marked == first);
+        // Halves and quarters of integers: every partial sum is exact in double, in any order.
+        CHECK(motion.kinetic_energy == sum);
+        CHECK(motion.max_speed2 == max);
+        CHECK(motion.first_bad == first);
+        CHECK(density.sum == quarter_sum);
+        CHECK(density.max == max_negative);
     }
 }
 
