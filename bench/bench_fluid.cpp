@@ -93,11 +93,11 @@ Result measure(const Options& o, const std::string& name, const SimulationSetup&
     std::string stages;
     char cell[64];
     for (std::size_t k = 0; k < r.stages.size(); ++k) {
-        std::snprintf(cell, sizeof cell, " %s %.2f", r.stages[k].c_str(), r.stage_median_ms[k]);
+        std::snprintf(cell, sizeof cell, "%s%s %.2f", k ? " " : "", r.stages[k].c_str(), r.stage_median_ms[k]);
         stages += cell;
     }
     std::fprintf(stderr, "  %-34s %9ld fluid %8.2f ms/step (%s; %.1f iterations, %.0f bytes/fluid particle)\n",
-                 name.c_str(), r.fluid, r.total_median_ms, stages.c_str() + 1, r.iterations_avg, r.bytes_per_fluid);
+                 name.c_str(), r.fluid, r.total_median_ms, stages.c_str(), r.iterations_avg, r.bytes_per_fluid);
     return r;
 }
 

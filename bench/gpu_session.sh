@@ -19,7 +19,8 @@
 #             neighbour lists and viscosity), the cantilever (solids), the cantilever in a pool
 #             (fluid and a moving solid, viscosity, linear cell order), test_cuda_backend
 #   bench     bench/run_benchmarks.sh build-gpu --large: the fluid benchmark on CUDA only
-#             (BENCH_BACKENDS=cuda), then bench_lsm (every backend) and bench_sampling
+#             (BENCH_BACKENDS=cuda; dam breaks first, each section written as it finishes), then
+#             bench_lsm (every backend); the host-only sampling benchmark is left out
 #   ncu       a 1M-particle dam break, 3 steps: every kernel's time, then `--set basic` on the
 #             five kernels that take the most time (skipped under gVisor, where ncu cannot read
 #             the counters)
