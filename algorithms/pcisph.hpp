@@ -13,8 +13,10 @@
 
 MW_BACKEND_BEGIN
 
+// One per kernel (sph_kernels.hpp): the solver's functions below are templates over it.
+template <class Kernel>
 struct FluidConstants {
-    SphKernel kernel;
+    Kernel kernel;
     Real rest_density = 0;    // ρ0
     Real mass = 0;            // fluid particle mass
     Real viscosity = 0;       // μ
@@ -38,8 +40,9 @@ struct DensityErrorOp {
 // moving solids see moving solids and static walls. Branch-free terms (W_r2 is 0 out of range by
 // itself), as in the PCISPH sums: a boundary particle's neighbourhood is dense (walls at r0/2), and
 // whether a candidate is in range is unpredictable.
-inline void compute_boundary_volumes(GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
-                                     std::size_t count, bool moving, SphKernel kernel) {
+template <class Kernel>
+void compute_boundary_volumes(GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
+                              std::size_t count, bool moving, Kernel kernel) {
     parallel_for("boundary_volume", count, [=] MW_HD(std::size_t k) {
         const std::size_t b = first + k;
         const Vec3 xb = position[b];
@@ -62,10 +65,11 @@ inline void compute_boundary_volumes(GridView grid, View<const Vec3> position, V
 // Written against the gather interface (grid or lists); every term is 0 by itself for a pair out
 // of range and for i itself (v_i - v_i), so no test is needed. (i's own image is not 0: it brakes
 // i's velocity into the wall, which the fluid pairs cannot see when all move alike.)
-template <class Neighbors>
+template <class Neighbors, class Kernel>
 void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> position,
                                     View<const Vec3> velocity, View<const Real> density,
-                                    View<const Real> boundary_volume, View<Vec3> acceleration, FluidConstants c) {
+                                    View<const Real> boundary_volume, View<Vec3> acceleration,
+                                    FluidConstants<Kernel> c) {
     const bool friction = c.wall_viscosity > Real(0);
     const Real h2 = c.kernel.h * c.kernel.h;
     parallel_for("viscosity", fluid_count, [=] MW_HD(std::size_t i) {
@@ -108,11 +112,11 @@ inline void predict_positions(std::size_t fluid_count, View<const Vec3> position
 // Predicted density from fluid (at predicted positions) and boundary particles, then
 // p_i += δ (ρ*_i - ρ0), clamped at 0 (free-surface particle deficiency), and p_i/ρ_i².
 // The first iteration of a step starts from p = 0 (so no separate pass clears the pressure).
-template <class Neighbors>
+template <class Neighbors, class Kernel>
 void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
                                   View<const Vec3> position, View<const Real> boundary_volume, View<Real> density,
-                                  View<Real> pressure, View<Real> pressure_term, FluidConstants c, Real delta,
-                                  bool first_iteration) {
+                                  View<Real> pressure, View<Real> pressure_term, FluidConstants<Kernel> c,
+                                  Real delta, bool first_iteration) {
     parallel_for("pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         const Real fluid_sum = neighbors.sum_fluid(i, position[i], [&](std::uint32_t j) {
@@ -141,10 +145,10 @@ inline DensityError density_error(std::size_t fluid_count, View<const Real> dens
 }
 
 // a_p,i = -m Σ_j (p_i/ρ_i² + p_j/ρ_j²) ∇W(x*_ij) - Σ_b ψ_b (p_i/ρ_i²) ∇W(x*_i - x_b).
-template <class Neighbors>
+template <class Neighbors, class Kernel>
 void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
                            View<const Vec3> position, View<const Real> boundary_volume,
-                           View<const Real> pressure_term, View<Vec3> pressure_acc, FluidConstants c) {
+                           View<const Real> pressure_term, View<Vec3> pressure_acc, FluidConstants<Kernel> c) {
     parallel_for("pcisph_pressure_force", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         const Real pi_rho2 = pressure_term[i];

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "algorithms/particle_types.hpp"
+#include "algorithms/sph_kernels.hpp"
 #include "algorithms/vec3.hpp"
 
 namespace mw {
@@ -19,6 +20,7 @@ struct FluidParams {
     Real rest_density = 1000;     // ρ0, kg/m³
     Real spacing = 0.02;          // r0, m
     Real support_radius = 0.04;   // h, m
+    KernelKind kernel = KernelKind::kCubicSpline;  // W for density and pressure (sph_kernels.hpp)
     Real viscosity = 0;           // μ, Pa·s (Eq. 4)
     Real wall_viscosity = 0;      // μ of fluid–wall friction, Pa·s (Eq. 8); 0: free-slip walls
     // The viscosity stage runs only when one of the two is positive.

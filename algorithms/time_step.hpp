@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -20,6 +21,8 @@
 
 MW_BACKEND_BEGIN
 
+// One class per smoothing kernel (sph_kernels.hpp); make_simulation() below picks the scene's.
+template <class Kernel>
 class BackendSimulation final : public Simulation {
    public:
     explicit BackendSimulation(const SimulationSetup& setup);
@@ -237,7 +240,7 @@ class BackendSimulation final : public Simulation {
     // First, so that it goes last: the backend frees its shared scratch when no simulation is left.
     ScratchUser scratch_user_;
     SimulationParams params_;
-    FluidConstants fluid_;
+    FluidConstants<Kernel> fluid_;
     double delta_times_dt2_ = 0;  // δ·Δt², from the prototype lattice
     ParticleStore store_;
     NeighborGrid grid_;
@@ -265,7 +268,8 @@ class BackendSimulation final : public Simulation {
     StepReport report_;
 };
 
-inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : params_(setup.params) {
+template <class Kernel>
+BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : params_(setup.params) {
     const std::size_t n = setup.position.size();
     if (setup.velocity.size() != n || setup.type.size() != n || setup.object.size() != n)
         throw InputError("simulation setup: position, velocity, type and object lists differ in length");
@@ -319,7 +323,7 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
                     params_.cells_per_support);
     grid_.build_static(store_);
 
-    fluid_.kernel = SphKernel::with_support(h);
+    fluid_.kernel = Kernel::with_support(h);
     fluid_.rest_density = fp.rest_density;
     fluid_.viscosity = fp.viscosity;
     fluid_.wall_viscosity = fp.wall_viscosity;
@@ -388,7 +392,8 @@ inline BackendSimulation::BackendSimulation(const SimulationSetup& setup) : para
     last_max_speed_ = std::sqrt(max_speed2);
 }
 
-inline void BackendSimulation::download(HostParticles& out) const {
+template <class Kernel>
+void BackendSimulation<Kernel>::download(HostParticles& out) const {
     const std::size_t n = store_.size();
     const std::vector<std::uint32_t> id = store_.id.to_host();
     const std::vector<Vec3> position = store_.position.to_host(), velocity = store_.velocity.to_host();
@@ -412,6 +417,16 @@ inline void BackendSimulation::download(HostParticles& out) const {
         out.type[i] = type[k];
         out.object[i] = object[k];
     }
+}
+
+// The simulation for the scene's kernel. Each kernel's instantiation has a source file of its own
+// in each backend (simulation_<backend>.cpp/.cu for the cubic spline, *_wendland for Wendland C2),
+// so that the two compile in parallel; a step then runs its kernel inline, with no branch on it.
+std::unique_ptr<Simulation> make_cubic_spline_simulation(const SimulationSetup& setup);
+std::unique_ptr<Simulation> make_wendland_c2_simulation(const SimulationSetup& setup);
+inline std::unique_ptr<Simulation> make_simulation(const SimulationSetup& setup) {
+    if (setup.params.fluid.kernel == KernelKind::kWendlandC2) return make_wendland_c2_simulation(setup);
+    return make_cubic_spline_simulation(setup);
 }
 
 MW_BACKEND_END

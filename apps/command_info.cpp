@@ -55,6 +55,8 @@ int command_info(int argc, char** argv) {
         j["particles"] = p;
         j["fluid_carved"] = carved_fluid;
         if (scene.walls) j["wall_gap_m"] = wall_gap;  // the first wall layer's distance outside the faces
+        j["warnings"] = SceneJson::array();
+        if (const std::string warning = scene.kernel_warning(); !warning.empty()) j["warnings"].push_back(warning);
         j["backend"] = backend;
         j["device_bytes"] = bytes;
         j["bytes_per_particle"] = bytes_per_particle;
@@ -83,9 +85,11 @@ int command_info(int argc, char** argv) {
     // Whether the viscosity stage runs is the simulation's decision (it also needs fluid, and wall
     // friction needs walls), so it is read from the stage list rather than guessed from the keys.
     const bool runs_viscosity = std::find(stages.begin(), stages.end(), "viscosity") != stages.end();
-    std::printf("fluid       r0 %g m, h %g m, rest density %g kg/m3, viscosity %g Pa s, wall viscosity %g Pa s%s\n",
-                double(f.spacing), double(f.support_radius), double(f.rest_density), double(f.viscosity),
-                double(f.wall_viscosity), runs_viscosity ? "" : " (viscosity stage off)");
+    std::printf("fluid       r0 %g m, h %g m (%.3g r0, %s kernel), rest density %g kg/m3, viscosity %g Pa s, wall "
+                "viscosity %g Pa s%s\n",
+                double(f.spacing), double(f.support_radius), double(f.support_radius / f.spacing),
+                kernel_name(f.kernel), double(f.rest_density), double(f.viscosity), double(f.wall_viscosity),
+                runs_viscosity ? "" : " (viscosity stage off)");
     char stopping_rule[96];
     if (solver.eta_max > 0)
         std::snprintf(stopping_rule, sizeof stopping_rule, "density error < %g average, < %g peak", double(solver.eta),
@@ -108,6 +112,7 @@ int command_info(int argc, char** argv) {
                     double(f.support_radius / f.spacing), scene.static_boxes.size());
     else
         std::printf("boundary    no domain walls; %zu static box(es)\n", scene.static_boxes.size());
+    if (const std::string warning = scene.kernel_warning(); !warning.empty()) std::printf("warning     %s\n", warning.c_str());
     return 0;
 }
 

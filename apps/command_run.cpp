@@ -155,6 +155,8 @@ int command_run(int argc, char** argv) {
     else std::snprintf(stop, sizeof stop, "time %g s", end_time);
     summary.stop_condition = stop;
 
+    if (const std::string warning = scene.kernel_warning(); !warning.empty())
+        std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
     if (!quiet) {
         const ParticleCounts& c = summary.particles;
         // Carving changes how much fluid a scene holds: say so where the counts are given.

@@ -67,6 +67,9 @@ struct Scene {
     // How far outside the domain faces the walls' first layer goes (sampling/wall_gap.hpp), m.
     Real wall_gap() const;
     bool writes_vtu() const;
+    // A warning for a kernel the scene's support radius makes unstable ("" when there is none):
+    // the cubic spline wider than 2.25 r0 (docs/solver.md, "Kernels").
+    std::string kernel_warning() const;
 };
 
 // The built-in default scene (scenes/dam_break.json, embedded at configure time).

@@ -6,6 +6,7 @@
 //      the scenes' default peak bound (eta_max 5%) and with the peak bounded at 1%.
 //   3. The same dam break with linear and Z-order cell orderings, with grid gathers, and with
 //      viscosity (Eq. 4 with the fluid's mirror images across the walls; the backend's gathers).
+//   4. The Wendland C2 kernel at h = 2 r0 and 2.5 r0 (fluid.kernel).
 // Prints a Markdown report and, with --out FILE, appends it there, each section as soon as it is
 // measured.
 #include <algorithm>
@@ -34,6 +35,11 @@ struct Options {
     bool large = false;
     bool quick = false;
     std::string out;
+    // The report's sections to run (--sections, comma-separated): all by default.
+    std::vector<std::string> sections{"dams", "splish", "variants", "kernels"};
+    bool wants(const std::string& section) const {
+        return std::find(sections.begin(), sections.end(), section) != sections.end();
+    }
 };
 
 struct Result {
@@ -102,15 +108,18 @@ Result measure(const Options& o, const std::string& name, const SimulationSetup&
 }
 
 // A dam break of about `target` fluid particles: a 0.6 x 0.8 x 0.8 m column in a 1.6 x 1.0 x
-// 0.8 m tank (the default scene's shape), spacing chosen for the count, dt scaled with spacing.
-SimulationSetup dam_break(long target, CellOrdering ordering) {
+// 0.8 m tank (the default scene's shape), spacing chosen for the count, dt scaled with spacing;
+// the kernel `kernel` with support `support_in_r0` r0.
+SimulationSetup dam_break(long target, CellOrdering ordering, KernelKind kernel = KernelKind::kCubicSpline,
+                          Real support_in_r0 = 2) {
     const double volume = 0.6 * 0.8 * 0.8;
     const Real r0 = Real(std::cbrt(volume / double(target)));
     SimulationSetup s;
     s.params.domain_min = {0, 0, 0};
     s.params.domain_max = {1.6f, 1.0f, 0.8f};
     s.params.fluid.spacing = r0;
-    s.params.fluid.support_radius = 2 * r0;
+    s.params.fluid.support_radius = support_in_r0 * r0;
+    s.params.fluid.kernel = kernel;
     s.params.solver.dt = Real(0.0015 * r0 / 0.02);
     s.params.solver.eta_max = Real(default_eta_max(s.params.solver.eta));  // the scenes' stopping rule
     s.params.ordering = ordering;
@@ -119,7 +128,7 @@ SimulationSetup dam_break(long target, CellOrdering ordering) {
         s.type.push_back(kFluid);
     }
     s.params.domain_walls = true;
-    const Real gap = rest_density_wall_gap(r0, s.params.fluid.support_radius, r0 / 2, 1);
+    const Real gap = rest_density_wall_gap(r0, s.params.fluid.support_radius, r0 / 2, 1, kernel);
     for (const Vec3& p : sample_container_walls(s.params.domain_min, s.params.domain_max, r0 / 2, 1, gap)) {
         s.position.push_back(p);
         s.type.push_back(kStaticBoundary);
@@ -177,9 +186,22 @@ int main(int argc, char** argv) {
         else if (a == "--out" && i + 1 < argc) o.out = argv[++i];
         else if (a == "--large") o.large = true;
         else if (a == "--quick") o.quick = true;
-        else {
+        else if (a == "--sections" && i + 1 < argc) {
+            std::vector<std::string> chosen;
+            std::stringstream list(argv[++i]);
+            for (std::string name; std::getline(list, name, ',');) {
+                if (!Options{}.wants(name)) {  // the default holds every section
+                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels)\n",
+                                 name.c_str());
+                    return 2;
+                }
+                chosen.push_back(name);
+            }
+            o.sections = chosen;
+        } else {
             std::fprintf(stderr,
-                         "usage: bench_fluid [--backend openmp|cuda] [--threads N] [--large] [--quick] [--out FILE]\n");
+                         "usage: bench_fluid [--backend openmp|cuda] [--threads N] [--large] [--quick] "
+                         "[--sections dams,splish,variants,kernels] [--out FILE]\n");
             return 2;
         }
     }
@@ -216,61 +238,87 @@ int main(int argc, char** argv) {
         const double in_motion = 0.15;
         auto warmup_time = [&](long n) { return gpu || n <= 100000 ? in_motion : 0.0; };
         auto measured_steps = [&](long n) { return gpu ? 30 : n >= 1000000 ? 3 * scale : 10 * scale; };
-        std::vector<Result> dams;
-        std::vector<long> sizes = {25000, 100000, 1000000};
-        if (o.large) sizes.push_back(4000000);
-        for (long n : sizes)
-            dams.push_back(measure(o, "dam break " + std::to_string(n / 1000) + "k", dam_break(n, CellOrdering::kZOrder),
-                                   measured_steps(n), 2, warmup_time(n)));
-        emit("### Dam breaks (0.6 x 0.8 x 0.8 m column, 1.6 x 1.0 x 0.8 m tank, dt = 0.0015 s x r0/0.02 m, "
-             "eta 1%, eta_max 5%; measured from the simulated time 'from t')\n\n" +
-             format_table(dams) + "\n");
-
-        std::vector<Result> splish;
-        for (const char* spacing : {"0.05", "0.025"}) {
-            // A block of edge 1 m - r0 holds the peer's counts: 19³ = 6,859 and 39³ = 59,319.
-            const double r0 = std::atof(spacing), edge = 1.0 - r0;
-            const std::string corner = "[" + std::to_string(edge) + "," + std::to_string(edge) + "," + std::to_string(edge) + "]";
-            const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/splishsplash_block.json",
-                                           {std::string("fluid.spacing=") + spacing,
-                                            "fluid.support_radius=" + std::to_string(2 * r0), "fluid_blocks.0.max=" + corner});
-            // The whole collapse of the block: 1 s of simulated time (300 steps with --quick).
-            const int steps = o.quick ? 300 : 1000;
-            const int case_steps = std::string(spacing) == "0.05" ? steps : steps / 4;
-            SimulationSetup setup = build_setup(scene);
-            splish.push_back(measure(o, std::string("SPlisHSPlasH block, r0 ") + spacing + " m", setup, case_steps, 0));
-            // The same with the peak density error bounded at 1% (solver.eta_max): the price of
-            // matching the peer's peak error.
-            setup.params.solver.eta_max = Real(0.01);
-            splish.push_back(measure(o, std::string("SPlisHSPlasH block, r0 ") + spacing + " m, eta_max 1%", setup,
-                                     case_steps, 0));
+        if (o.wants("dams")) {
+            std::vector<Result> dams;
+            std::vector<long> sizes = {25000, 100000, 1000000};
+            if (o.large) sizes.push_back(4000000);
+            for (long n : sizes)
+                dams.push_back(measure(o, "dam break " + std::to_string(n / 1000) + "k", dam_break(n, CellOrdering::kZOrder),
+                                       measured_steps(n), 2, warmup_time(n)));
+            emit("### Dam breaks (0.6 x 0.8 x 0.8 m column, 1.6 x 1.0 x 0.8 m tank, dt = 0.0015 s x r0/0.02 m, "
+                 "eta 1%, eta_max 5%; measured from the simulated time 'from t')\n\n" +
+                 format_table(dams) + "\n");
         }
-        emit("### SPlisHSPlasH comparison (scenes/splishsplash_block.json; dt 0.001 s, eta 1%, >= 3 iterations; "
-             "eta_max 5%, the scenes' default, unless the case says 1%)\n\n" +
-             format_table(splish) +
-             "\nPeer (from the issue, SPlisHSPlasH PCISPH + Akinci, 2 threads on this kind of machine): 17-20 ms "
-             "per step at 0.05 m, 187 ms at 0.025 m; peak density 0.3-1% above rest.\n\n");
 
-        std::vector<Result> variants;
-        for (CellOrdering ordering : {CellOrdering::kLinear, CellOrdering::kZOrder})
-            variants.push_back(measure(o, ordering == CellOrdering::kLinear ? "dam break 100k, linear cells, lists"
-                                                                            : "dam break 100k, Z-order cells, lists",
-                                       with_lists(dam_break(100000, ordering), true), measured_steps(100000), 2,
-                                       warmup_time(100000)));
-        // Gathering from the grid in every iteration: CUDA's default, and its memory layout.
-        for (long n : {100000L, 1000000L})
-            variants.push_back(measure(o, "dam break " + std::to_string(n / 1000) + "k, Z-order, grid gathers",
-                                       with_lists(dam_break(n, CellOrdering::kZOrder), false), measured_steps(n), 2,
-                                       warmup_time(n)));
-        // The viscosity stage, which the dam breaks above do not run: the paper's μ = 0.05 Pa s.
-        {
-            SimulationSetup viscous = dam_break(100000, CellOrdering::kZOrder);
-            viscous.params.fluid.viscosity = Real(0.05);
-            variants.push_back(measure(o, "dam break 100k, Z-order, viscosity 0.05 Pa s", viscous,
-                                       measured_steps(100000), 2, warmup_time(100000)));
+        if (o.wants("splish")) {
+            std::vector<Result> splish;
+            for (const char* spacing : {"0.05", "0.025"}) {
+                // A block of edge 1 m - r0 holds the peer's counts: 19³ = 6,859 and 39³ = 59,319.
+                const double r0 = std::atof(spacing), edge = 1.0 - r0;
+                const std::string corner = "[" + std::to_string(edge) + "," + std::to_string(edge) + "," + std::to_string(edge) + "]";
+                const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/splishsplash_block.json",
+                                               {std::string("fluid.spacing=") + spacing,
+                                                "fluid.support_radius=" + std::to_string(2 * r0), "fluid_blocks.0.max=" + corner});
+                // The whole collapse of the block: 1 s of simulated time (300 steps with --quick).
+                const int steps = o.quick ? 300 : 1000;
+                const int case_steps = std::string(spacing) == "0.05" ? steps : steps / 4;
+                SimulationSetup setup = build_setup(scene);
+                splish.push_back(measure(o, std::string("SPlisHSPlasH block, r0 ") + spacing + " m", setup, case_steps, 0));
+                // The same with the peak density error bounded at 1% (solver.eta_max): the price of
+                // matching the peer's peak error.
+                setup.params.solver.eta_max = Real(0.01);
+                splish.push_back(measure(o, std::string("SPlisHSPlasH block, r0 ") + spacing + " m, eta_max 1%", setup,
+                                         case_steps, 0));
+            }
+            emit("### SPlisHSPlasH comparison (scenes/splishsplash_block.json; dt 0.001 s, eta 1%, >= 3 iterations; "
+                 "eta_max 5%, the scenes' default, unless the case says 1%)\n\n" +
+                 format_table(splish) +
+                 "\nPeer (from the issue, SPlisHSPlasH PCISPH + Akinci, 2 threads on this kind of machine): 17-20 ms "
+                 "per step at 0.05 m, 187 ms at 0.025 m; peak density 0.3-1% above rest.\n\n");
         }
-        emit("### Variants: cell order, neighbour lists or grid gathers, viscosity\n\n" + format_table(variants) +
-             "\n");
+
+        if (o.wants("variants")) {
+            std::vector<Result> variants;
+            for (CellOrdering ordering : {CellOrdering::kLinear, CellOrdering::kZOrder})
+                variants.push_back(measure(o, ordering == CellOrdering::kLinear ? "dam break 100k, linear cells, lists"
+                                                                                : "dam break 100k, Z-order cells, lists",
+                                           with_lists(dam_break(100000, ordering), true), measured_steps(100000), 2,
+                                           warmup_time(100000)));
+            // Gathering from the grid in every iteration: CUDA's default, and its memory layout.
+            for (long n : {100000L, 1000000L})
+                variants.push_back(measure(o, "dam break " + std::to_string(n / 1000) + "k, Z-order, grid gathers",
+                                           with_lists(dam_break(n, CellOrdering::kZOrder), false), measured_steps(n), 2,
+                                           warmup_time(n)));
+            // The viscosity stage, which the dam breaks above do not run: the paper's μ = 0.05 Pa s.
+            {
+                SimulationSetup viscous = dam_break(100000, CellOrdering::kZOrder);
+                viscous.params.fluid.viscosity = Real(0.05);
+                variants.push_back(measure(o, "dam break 100k, Z-order, viscosity 0.05 Pa s", viscous,
+                                           measured_steps(100000), 2, warmup_time(100000)));
+            }
+            emit("### Variants: cell order, neighbour lists or grid gathers, viscosity\n\n" + format_table(variants) +
+                 "\n");
+        }
+
+        // The kernel (fluid.kernel), side by side. The cubic spline at h = 2.5 r0 is left out: it
+        // throws particles by t = 0.03 s and its step falls to microseconds before the measurement
+        // starts (docs/solver.md, "Kernels").
+        if (o.wants("kernels")) {
+            struct KernelCase {
+                const char* name;
+                KernelKind kernel;
+                Real support_in_r0;
+            };
+            std::vector<Result> kernels;
+            for (const KernelCase c : {KernelCase{"cubic spline, h = 2 r0", KernelKind::kCubicSpline, 2},
+                                       KernelCase{"Wendland C2, h = 2 r0", KernelKind::kWendlandC2, 2},
+                                       KernelCase{"Wendland C2, h = 2.5 r0", KernelKind::kWendlandC2, 2.5}})
+                kernels.push_back(measure(o, std::string("dam break 100k, ") + c.name,
+                                          with_lists(dam_break(100000, CellOrdering::kZOrder, c.kernel, c.support_in_r0),
+                                                     true),
+                                          measured_steps(100000), 2, warmup_time(100000)));
+            emit("### Kernels (fluid.kernel), Z-order cells, neighbour lists\n\n" + format_table(kernels) + "\n");
+        }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_fluid: %s\n", e.what());
         return 1;

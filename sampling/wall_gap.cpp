@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/sph_kernels.hpp"
 #include "backend/errors.hpp"
 
 namespace mw {
@@ -21,7 +20,8 @@ std::string format_length(double x) {
 // straight across. The grid's lateral offset against the fluid changes the first layer's density
 // by less than 1e-4 of ρ0 for spacings up to r0/2 (the default); at a spacing of r0 by up to 0.3%
 // for h = 2 to 2.5 r0 and 2% for h = 1.5 r0 (measured in review, twelfth session).
-double sheet_sum(const SphKernel& kernel, double spacing, double dz) {
+template <class Kernel>
+double sheet_sum(const Kernel& kernel, double spacing, double dz) {
     const int reach = static_cast<int>(std::ceil(double(kernel.h) / spacing)) + 1;
     double sum = 0;
     for (int j = -reach; j <= reach; ++j)
@@ -31,13 +31,10 @@ double sheet_sum(const SphKernel& kernel, double spacing, double dz) {
         }
     return sum;
 }
-}  // namespace
 
-Real rest_density_wall_gap(Real r0_in, Real h_in, Real boundary_spacing_in, int layers) {
-    const double r0 = r0_in, h = h_in, s = boundary_spacing_in;
-    if (!(r0 > 0) || !(h > r0) || !(s > 0) || layers < 1)
-        throw InputError("wall gap: need spacing > 0, support radius > spacing, boundary spacing > 0, layers >= 1");
-    const SphKernel kernel = SphKernel::with_support(Real(h));
+template <class Kernel>
+Real wall_gap_for(const Kernel& kernel, double r0, double s, int layers) {
+    const double h = kernel.h;
     const int reach = static_cast<int>(std::ceil(h / r0)) + 1;
 
     // The fluid mass makes a full lattice the rest density: ρ0 = m Σ W (ρ0 cancels below, so
@@ -75,6 +72,13 @@ Real rest_density_wall_gap(Real r0_in, Real h_in, Real boundary_spacing_in, int 
         (density(mid) > 1 ? lo : hi) = mid;
     }
     return Real(0.5 * (lo + hi));
+}
+}  // namespace
+
+Real rest_density_wall_gap(Real r0, Real h, Real boundary_spacing, int layers, KernelKind kernel) {
+    if (!(r0 > 0) || !(h > r0) || !(boundary_spacing > 0) || layers < 1)
+        throw InputError("wall gap: need spacing > 0, support radius > spacing, boundary spacing > 0, layers >= 1");
+    return with_kernel(kernel, h, [&](const auto& w) { return wall_gap_for(w, r0, boundary_spacing, layers); });
 }
 
 }  // namespace mw

@@ -1,4 +1,4 @@
-// The CUDA instantiation of the algorithms, and its factory.
+// The CUDA instantiation of the algorithms for the cubic spline, and the backend's factory.
 #define MW_BACKEND_CUDA
 #include "algorithms/time_step.hpp"
 #include "backend/backend_registry.hpp"
@@ -17,7 +17,13 @@ std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup)
     const std::string why_not = cuda_backend::unavailable_reason();
     if (!why_not.empty()) throw DeviceError("the CUDA backend was requested but is unusable: " + why_not);
     // The command line adds the scene's particle count and memory estimate to a DeviceError.
-    return std::make_unique<cuda_backend::BackendSimulation>(setup);
+    return cuda_backend::make_simulation(setup);
 }
 
 }  // namespace mw
+
+MW_BACKEND_BEGIN
+std::unique_ptr<Simulation> make_cubic_spline_simulation(const SimulationSetup& setup) {
+    return std::make_unique<BackendSimulation<CubicSpline3D>>(setup);
+}
+MW_BACKEND_END

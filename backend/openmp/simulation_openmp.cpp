@@ -1,4 +1,4 @@
-// The OpenMP instantiation of the algorithms, and its factory.
+// The OpenMP instantiation of the algorithms for the cubic spline, and the backend's factory.
 #define MW_BACKEND_OPENMP
 #include "algorithms/time_step.hpp"
 #include "backend/backend_registry.hpp"
@@ -16,7 +16,13 @@ void set_host_threads(int threads) {
 
 std::unique_ptr<Simulation> create_openmp_simulation(const SimulationSetup& setup, int threads) {
     openmp_backend::set_threads(threads);
-    return std::make_unique<openmp_backend::BackendSimulation>(setup);
+    return openmp_backend::make_simulation(setup);
 }
 
 }  // namespace mw
+
+MW_BACKEND_BEGIN
+std::unique_ptr<Simulation> make_cubic_spline_simulation(const SimulationSetup& setup) {
+    return std::make_unique<BackendSimulation<CubicSpline3D>>(setup);
+}
+MW_BACKEND_END

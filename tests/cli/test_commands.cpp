@@ -263,6 +263,33 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(jc["device_bytes"].get<long>() < jo["device_bytes"].get<long>());
 }
 
+TEST_CASE("info: the kernel, and a warning for the cubic spline at a support it is unstable at") {
+    const Result d = run("info");
+    REQUIRE(d.code == 0);
+    CHECK(contains(d.out, "2 r0, cubic_spline kernel"));
+    CHECK(!contains(d.out, "warning"));
+    // The paper's h = 2.5 r0 with the cubic spline: warned (docs/solver.md, "Kernels").
+    const Result wide = run("info --set fluid.support_radius=0.05");
+    REQUIRE(wide.code == 0);
+    CHECK(contains(wide.out, "warning"));
+    CHECK(contains(wide.out, "pairing instability"));
+    CHECK(contains(wide.out, "wendland_c2"));
+    const Result wendland = run("info --set fluid.support_radius=0.05 --set fluid.kernel=wendland_c2 --json");
+    REQUIRE(wendland.code == 0);
+    const auto j = nlohmann::json::parse(wendland.out);
+    CHECK(j["warnings"].empty());
+    CHECK(j["scene"]["fluid"]["kernel"] == "wendland_c2");
+    // The walls sit where the chosen kernel starts the fluid at rest: Wendland C2's gap differs.
+    const auto cubic = nlohmann::json::parse(run("info --set fluid.support_radius=0.05 --json").out);
+    CHECK(cubic["warnings"].size() == 1);
+    CHECK(j["wall_gap_m"].get<double>() < 0.97 * cubic["wall_gap_m"].get<double>());  // 0.699 r0 against 0.740 r0
+    // A run says it too.
+    const Result r = run("run --set fluid.support_radius=0.05 --steps 1 --quiet --set 'output.formats=[]' --out " +
+                         scratch_dir() + "/wide");
+    CHECK(r.code == 0);
+    CHECK(contains(r.err, "pairing instability"));
+}
+
 TEST_CASE("bad input: a moving object that starts inside another object or a static box") {
     // 0.04 m cubes at r0 = 0.02 m: 2 x 2 x 2 inner particles, 0.01 m inside each face.
     const auto cube = [](const std::string& kind, double x) {

@@ -76,6 +76,7 @@ TEST_CASE("defaults are filled in and recorded in the resolved scene") {
     const Scene s = parse_scene_text(tiny_scene_text(), "t");
     CHECK(s.params.fluid.rest_density == doctest::Approx(1000));
     CHECK(s.params.fluid.support_radius == doctest::Approx(0.04));
+    CHECK(s.params.fluid.kernel == KernelKind::kCubicSpline);
     CHECK(s.params.fluid.viscosity == 0);
     CHECK(s.params.gravity.y == doctest::Approx(-9.81));
     CHECK(s.params.solver.dt_mode == TimeStepMode::kFixed);
@@ -95,6 +96,7 @@ TEST_CASE("defaults are filled in and recorded in the resolved scene") {
     CHECK(r["fluid"]["support_radius"].get<double>() == doctest::Approx(0.04));
     CHECK(r["gravity"][1].get<double>() == doctest::Approx(-9.81));
     CHECK(r["solver"]["dt_mode"] == "fixed");
+    CHECK(r["fluid"]["kernel"] == "cubic_spline");
     CHECK(r["solver"]["eta_max"].get<double>() == 0.05);  // computed in double: no float residue
     CHECK(r["neighbors"]["ordering"] == "zorder");
     CHECK(r["fluid_blocks"][0]["velocity"].size() == 3);
@@ -111,7 +113,8 @@ TEST_CASE("--set overrides reach every kind of key") {
                                       "fluid_blocks.0.velocity=[1,0,0]", "fluid_blocks[0].max=[0.1,0.12,0.1]",
                                       "output.formats=[]", "name=renamed", "neighbors.ordering=\"linear\"",
                                       "static_boxes=[{\"min\":[0.15,0,0.15],\"max\":[0.2,0.05,0.2]}]",
-                                      "static_boxes.0.layers=2"});
+                                      "static_boxes.0.layers=2", "fluid.kernel=wendland_c2"});
+    CHECK(s.params.fluid.kernel == KernelKind::kWendlandC2);
     CHECK(s.params.solver.eta == doctest::Approx(0.005));
     CHECK(s.params.solver.dt_mode == TimeStepMode::kCfl);
     CHECK(s.params.gravity.y == doctest::Approx(-1));
@@ -179,6 +182,7 @@ TEST_CASE("bad scenes give one line naming the key") {
         {"layers out of range", tiny, {"boundary.layers=9"}, {"boundary.layers", "[1, 8]"}},
         {"iterations inverted", tiny, {"solver.max_iterations=2"}, {"solver.max_iterations", "min_iterations"}},
         {"bad choice", tiny, {"solver.dt_mode=adaptive"}, {"solver.dt_mode", "fixed, cfl", "adaptive"}},
+        {"unknown kernel", tiny, {"fluid.kernel=quintic"}, {"fluid.kernel", "cubic_spline, wendland_c2", "quintic"}},
         {"bad format", tiny, {"output.formats=[\"obj\"]"}, {"output.formats[0]", "vtu"}},
         {"2D", tiny, {"dimensions=2"}, {"dimensions", "only 3"}},
         {"inverted domain", tiny, {"domain.max=[0.2,-1,0.2]"}, {"domain.max", "exceed min"}},

@@ -17,9 +17,9 @@
 
 using namespace mw;
 
-TEST_CASE("cubic spline 3D integrates to one") {
+TEST_CASE_TEMPLATE("the 3D kernels integrate to one", Kernel, CubicSpline3D, WendlandC2_3D) {
     const double h = 0.1, step = h / 40;
-    const CubicSpline3D kernel = CubicSpline3D::with_support(Real(h));
+    const Kernel kernel = Kernel::with_support(Real(h));
     double integral = 0;
     for (double x = -h; x <= h; x += step)
         for (double y = -h; y <= h; y += step)
@@ -37,8 +37,9 @@ TEST_CASE("cubic spline 2D integrates to one") {
     CHECK(integral == doctest::Approx(1.0).epsilon(2e-3));
 }
 
-TEST_CASE("kernel gradient is antisymmetric, points inward and matches finite differences") {
-    const CubicSpline3D kernel = CubicSpline3D::with_support(Real(0.1));
+TEST_CASE_TEMPLATE("kernel gradient is antisymmetric, points inward and matches finite differences", Kernel,
+                   CubicSpline3D, WendlandC2_3D) {
+    const Kernel kernel = Kernel::with_support(Real(0.1));
     const Vec3 samples[] = {{0.01f, 0.02f, -0.03f}, {0.04f, 0.0f, 0.01f}, {-0.06f, 0.05f, 0.02f}, {0.0f, 0.0f, 0.09f}};
     for (Vec3 r : samples) {
         const Real d = norm(r);
@@ -55,9 +56,10 @@ TEST_CASE("kernel gradient is antisymmetric, points inward and matches finite di
     CHECK(kernel.W(Real(0.1)) == 0);
 }
 
-TEST_CASE("the branch-free forms of W, grad W and the viscosity Laplacian equal them, and vanish out of range") {
+TEST_CASE_TEMPLATE("the branch-free forms of W, grad W and the viscosity Laplacian equal them, and vanish out of range",
+                   Kernel, CubicSpline3D, WendlandC2_3D) {
     const Real h = Real(0.1);
-    const CubicSpline3D kernel = CubicSpline3D::with_support(h);
+    const Kernel kernel = Kernel::with_support(h);
     double worst_w = 0, worst_grad = 0, worst_laplacian = 0;
     for (int k = 1; k <= 400; ++k) {
         // Directions vary with k; distances run from near 0 to 1.2 h, across q = 1/2 and q = 1.
@@ -111,7 +113,7 @@ struct ViscosityRun {
     std::vector<std::uint32_t> id;
 };
 ViscosityRun run_viscosity(const std::vector<Vec3>& fluid, const std::vector<Vec3>& fluid_velocity,
-                           const std::vector<Vec3>& walls, const FluidConstants& c) {
+                           const std::vector<Vec3>& walls, const FluidConstants<CubicSpline3D>& c) {
     const std::size_t nf = fluid.size(), n = nf + walls.size();
     std::vector<Vec3> position = fluid, velocity = fluid_velocity;
     position.insert(position.end(), walls.begin(), walls.end());
@@ -155,9 +157,9 @@ ViscosityRun run_viscosity(const std::vector<Vec3>& fluid, const std::vector<Vec
     return out;
 }
 
-FluidConstants viscosity_constants(Real r0, Real viscosity, Real wall_viscosity) {
-    FluidConstants c;
-    c.kernel = SphKernel::with_support(2 * r0);
+FluidConstants<CubicSpline3D> viscosity_constants(Real r0, Real viscosity, Real wall_viscosity) {
+    FluidConstants<CubicSpline3D> c;
+    c.kernel = CubicSpline3D::with_support(2 * r0);
     c.rest_density = 1000;
     c.viscosity = viscosity;
     c.wall_viscosity = wall_viscosity;
@@ -168,7 +170,7 @@ FluidConstants viscosity_constants(Real r0, Real viscosity, Real wall_viscosity)
 
 // The lattice's Laplacian factor F = (m/ρ0) Σ Δy² ∇²W over the offsets of the lattice at spacing
 // r0 within h = 2 r0, in double: Eq. 4 on that lattice gives a_x = F μ c / ρ0 for v_x = c y².
-double lattice_laplacian_factor(const FluidConstants& c, Real r0) {
+double lattice_laplacian_factor(const FluidConstants<CubicSpline3D>& c, Real r0) {
     double sum_y2_lap = 0;
     for (int i = -2; i <= 2; ++i)
         for (int j = -2; j <= 2; ++j)
@@ -187,7 +189,7 @@ double lattice_laplacian_factor(const FluidConstants& c, Real r0) {
 // ∇²W = 0 wherever the neighbourhood is a full, symmetric lattice, so exactly 0 but for rounding.
 TEST_CASE("viscosity (Eq. 4) on a lattice: the discrete Laplacian of a quadratic field, zero for linear and rigid flow") {
     const Real r0 = 0.02f, mu = 0.01f;
-    const FluidConstants c = viscosity_constants(r0, mu, 0);
+    const FluidConstants<CubicSpline3D> c = viscosity_constants(r0, mu, 0);
     // Sums over the lattice offsets within h, in double: the scales of the terms that cancel for
     // linear and rigid fields (Σ |Δy| ∇²W, Σ |Δx| ∇²W).
     double magnitude_sum_linear = 0, magnitude_sum_rotation = 0;
@@ -286,7 +288,7 @@ TEST_CASE("viscosity (Eq. 4) on a lattice: the discrete Laplacian of a quadratic
 // component. Beyond h from the wall nothing acts (uniform flow: Eq. 4 gives 0 too).
 TEST_CASE("wall viscosity (Eq. 8) brakes fluid sliding along a wall, tangentially only") {
     const Real r0 = 0.02f, U = 1.5f, mu_wall = 0.2f;
-    const FluidConstants c = viscosity_constants(r0, 0.01f, mu_wall);
+    const FluidConstants<CubicSpline3D> c = viscosity_constants(r0, 0.01f, mu_wall);
     // As the scenes build it: fluid r0/2 above the face y = 0, one wall layer below it at the
     // scenes' gap (wall_gap.hpp) and spacing r0/2, reaching h beyond the fluid's sides.
     const Real gap = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1);
@@ -339,7 +341,7 @@ TEST_CASE("wall viscosity (Eq. 8) brakes fluid sliding along a wall, tangentiall
 // are put off the origin (a reflection's offset is twice the face's position).
 TEST_CASE("viscosity next to a free-slip wall: the fluid's mirror images stand in for the missing fluid") {
     const Real r0 = 0.02f, mu = 0.01f, y0 = 0.3f;  // every case has a face at y = y0
-    const FluidConstants bare = viscosity_constants(r0, mu, 0);
+    const FluidConstants<CubicSpline3D> bare = viscosity_constants(r0, mu, 0);
     const double rate = 3;
     // a for a Laplacian of 2c on the lattice: F μ c / ρ0 (the test above).
     const double unit = lattice_laplacian_factor(bare, r0) * mu * rate / bare.rest_density;
@@ -351,7 +353,7 @@ TEST_CASE("viscosity next to a free-slip wall: the fluid's mirror images stand i
         int near_count = 0, far_count = 0;
     };
     auto worst_deviation = [&](const std::vector<Vec3>& fluid, const std::vector<Vec3>& velocity,
-                               const FluidConstants& c, auto component, auto expected, auto checked, auto near) {
+                               const FluidConstants<CubicSpline3D>& c, auto component, auto expected, auto checked, auto near) {
         const ViscosityRun run = run_viscosity(fluid, velocity, {}, c);
         Worst worst;
         for (std::size_t k = 0; k < run.position.size(); ++k) {
@@ -367,7 +369,7 @@ TEST_CASE("viscosity next to a free-slip wall: the fluid's mirror images stand i
     const double rounding = 1e-4;  // as in the test above
 
     SUBCASE("one wall: fields along it, across it, and a normal velocity") {
-        FluidConstants mirrored = bare;
+        FluidConstants<CubicSpline3D> mirrored = bare;
         mirrored.mirrors = WallMirrors{Vec3{-1, y0, -1}, Vec3{1, 1, 1}, 1u << 2, bare.kernel.h};  // y = y0 only
         // 13 x 8 x 13 lattice r0/2 above the face.
         std::vector<Vec3> fluid;
@@ -428,7 +430,7 @@ TEST_CASE("viscosity next to a free-slip wall: the fluid's mirror images stand i
     SUBCASE("a corner: images across one, two and three walls, at low and high faces") {
         // Faces x = x0 and y = y0 (low) and z = z1 (high); an 8 x 8 x 8 lattice r0/2 from each.
         const Real x0 = -0.06f, z1 = 0.14f;
-        FluidConstants mirrored = bare;
+        FluidConstants<CubicSpline3D> mirrored = bare;
         mirrored.mirrors = WallMirrors{Vec3{x0, y0, -1}, Vec3{1, 1, z1}, (1u << 0) | (1u << 2) | (1u << 5),
                                        bare.kernel.h};
         std::vector<Vec3> fluid;
@@ -479,8 +481,8 @@ TEST_CASE("viscosity next to a free-slip wall: the fluid's mirror images stand i
 TEST_CASE("viscosity next to a free-slip wall: the mirror images are symmetric and only dissipate") {
     const Real r0 = 0.02f, mu = 0.01f;
     const Vec3 corner{0.1f, 0.3f, -0.2f};
-    const FluidConstants bare = viscosity_constants(r0, mu, 0);
-    FluidConstants mirrored = bare;
+    const FluidConstants<CubicSpline3D> bare = viscosity_constants(r0, mu, 0);
+    FluidConstants<CubicSpline3D> mirrored = bare;
     mirrored.mirrors = WallMirrors{corner, Vec3{1, 1, 1}, (1u << 0) | (1u << 2) | (1u << 4), bare.kernel.h};
     std::mt19937 random(7);
     std::uniform_real_distribution<float> unit_interval(-1, 1);
@@ -501,7 +503,7 @@ TEST_CASE("viscosity next to a free-slip wall: the mirror images are symmetric a
     for (const Vec3& x : fluid) outside += x.x < corner.x || x.y < corner.y || x.z < corner.z;
     REQUIRE(outside >= 10);
     // Σ_i m u_i · A(w)_i, and Σ m |u| |A(w)| as the scale of its rounding.
-    auto form = [&](const std::vector<Vec3>& u, const std::vector<Vec3>& w, const FluidConstants& c) {
+    auto form = [&](const std::vector<Vec3>& u, const std::vector<Vec3>& w, const FluidConstants<CubicSpline3D>& c) {
         const ViscosityRun run = run_viscosity(fluid, w, {}, c);
         double total = 0, scale = 0;
         for (std::size_t k = 0; k < run.position.size(); ++k) {

@@ -14,10 +14,11 @@
 using namespace mw;
 
 namespace {
-// About 10k fluid particles: a 0.2 x 0.4 x 0.12 m column at r0 = 0.01 in a 1 x 0.5 x 0.12 m tank.
-SimulationSetup small_dam_break() {
-    SimulationSetup setup =
-        test::fluid_in_box({0, 0, 0}, {1.0f, 0.5f, 0.12f}, {0, 0, 0}, {0.2f, 0.4f, 0.12f}, 0.01f, 0.001f);
+// About 10k fluid particles: a 0.2 x 0.4 x 0.12 m column at r0 = 0.01 in a 1 x 0.5 x 0.12 m tank,
+// with the cubic spline at h = 2 r0 or another kernel and support.
+SimulationSetup small_dam_break(KernelKind kernel = KernelKind::kCubicSpline, Real support_in_r0 = 2) {
+    SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {1.0f, 0.5f, 0.12f}, {0, 0, 0}, {0.2f, 0.4f, 0.12f}, 0.01f,
+                                               0.001f, true, support_in_r0, kernel);
     setup.params.fluid.viscosity = 0.01f;
     return setup;
 }
@@ -84,12 +85,13 @@ TEST_CASE("CUDA against CUDA: two runs are bitwise identical (grid gathers and n
 }
 
 namespace {
-void compare_cuda_with_openmp(SimulationParams::Lists lists) {
+void compare_cuda_with_openmp(SimulationParams::Lists lists, KernelKind kernel = KernelKind::kCubicSpline,
+                              Real support_in_r0 = 2) {
     if (!cuda_backend_info().available) {
         MW_SKIP(cuda_backend_info().description);
         return;
     }
-    SimulationSetup setup = small_dam_break();
+    SimulationSetup setup = small_dam_break(kernel, support_in_r0);
     setup.params.neighbor_lists = lists;  // the same neighbour structure on both sides
     const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 50);
     const HostParticles &cpu = runs.openmp, &gpu = runs.cuda;
@@ -111,6 +113,11 @@ TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break, grid gathers") {
 
 TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break, neighbour lists") {
     compare_cuda_with_openmp(SimulationParams::Lists::kOn);
+}
+
+// The other kernel is another instantiation of the whole solver on each backend.
+TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break, Wendland C2 at h = 2.5 r0, grid gathers") {
+    compare_cuda_with_openmp(SimulationParams::Lists::kOff, KernelKind::kWendlandC2, 2.5);
 }
 
 // Lists hold the pairs within h at the start of a step; grid gathers also see pairs that come

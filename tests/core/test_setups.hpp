@@ -22,14 +22,16 @@ namespace mw::test {
 
 // A box of fluid [block_lo, block_hi] in a domain [lo, hi] lined with Akinci walls at spacing r0/2,
 // the first layer rest_density_wall_gap() outside the faces (the fluid starts at rest density);
-// `walls` false leaves the domain open. The kernel's support radius is `support_in_r0` r0.
+// `walls` false leaves the domain open. The kernel is `kernel` with support radius `support_in_r0` r0.
 inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_hi, Real r0, Real dt,
-                                    bool walls = true, Real support_in_r0 = 2) {
+                                    bool walls = true, Real support_in_r0 = 2,
+                                    KernelKind kernel = KernelKind::kCubicSpline) {
     SimulationSetup setup;
     setup.params.domain_min = lo;
     setup.params.domain_max = hi;
     setup.params.fluid.spacing = r0;
     setup.params.fluid.support_radius = support_in_r0 * r0;
+    setup.params.fluid.kernel = kernel;
     setup.params.fluid.rest_density = 1000;
     setup.params.solver.dt = dt;
     for (const Vec3& p : fill_box_lattice(block_lo, block_hi, r0)) {
@@ -38,7 +40,7 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
     }
     setup.params.domain_walls = walls;
     if (walls) {
-        const Real gap = rest_density_wall_gap(r0, setup.params.fluid.support_radius, r0 / 2, 1);
+        const Real gap = rest_density_wall_gap(r0, setup.params.fluid.support_radius, r0 / 2, 1, kernel);
         for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, gap)) {
             setup.position.push_back(p);
             setup.type.push_back(kStaticBoundary);
@@ -153,8 +155,8 @@ class PointBins {
 
 // Akinci boundary volumes V_b = 1 / Σ_b' W(x_bb') over the points of `bins` (b itself included),
 // recomputed on the host, independently of the solver's compute_boundary_volumes.
-inline std::vector<double> akinci_volumes(const std::vector<Vec3>& boundary, const PointBins& bins,
-                                          const CubicSpline3D& kernel) {
+template <class Kernel>
+std::vector<double> akinci_volumes(const std::vector<Vec3>& boundary, const PointBins& bins, const Kernel& kernel) {
     std::vector<double> volume(boundary.size());
     for (std::size_t b = 0; b < boundary.size(); ++b) {
         double sum = 0;
