@@ -4,6 +4,7 @@
 #pragma once
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "algorithms/vec3.hpp"
 
@@ -123,6 +124,9 @@ struct WendlandC2_3D : RadialKernel<WendlandC2_3D> {
         return -grad_scale * q * a * a * a;
     }
 };
+
+// Kernels are captured by value in device lambdas.
+static_assert(std::is_trivially_copyable_v<CubicSpline3D> && std::is_trivially_copyable_v<WendlandC2_3D>);
 
 // Calls f(kernel) with the 3D kernel of `kind` and support h: where host code (the wall gap, a
 // factory) turns the scene's choice into the type the solver is written against.

@@ -197,6 +197,10 @@ int main(int argc, char** argv) {
                 }
                 chosen.push_back(name);
             }
+            if (chosen.empty()) {
+                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels\n");
+                return 2;
+            }
             o.sections = chosen;
         } else {
             std::fprintf(stderr,

@@ -291,7 +291,7 @@ TEST_CASE("wall viscosity (Eq. 8) brakes fluid sliding along a wall, tangentiall
     const FluidConstants<CubicSpline3D> c = viscosity_constants(r0, 0.01f, mu_wall);
     // As the scenes build it: fluid r0/2 above the face y = 0, one wall layer below it at the
     // scenes' gap (wall_gap.hpp) and spacing r0/2, reaching h beyond the fluid's sides.
-    const Real gap = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1);
+    const Real gap = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1, KernelKind::kCubicSpline);
     std::vector<Vec3> fluid, walls;
     for (int k = -4; k <= 4; ++k)
         for (int j = 0; j < 6; ++j)

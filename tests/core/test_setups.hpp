@@ -117,8 +117,9 @@ inline double largest_position_difference(const HostParticles& a, const HostPart
     return worst;
 }
 
-// The fluid particle mass the solver uses, ρ0 / Σ W over the lattice offsets within h = 2 r0
-// (docs/solver.md), summed independently of the solver's own prototype_sums.
+// The fluid particle mass the solver uses, ρ0 / Σ W over the lattice offsets within h (the loop
+// reaches 2 r0 on each axis: every offset within h for h up to 3 r0; docs/solver.md), summed
+// independently of the solver's own prototype_sums.
 template <class Kernel>
 double lattice_mass(const Kernel& kernel, double r0, double rest_density) {
     double sum = 0;
