@@ -155,8 +155,10 @@ int command_run(int argc, char** argv) {
     else std::snprintf(stop, sizeof stop, "time %g s", end_time);
     summary.stop_condition = stop;
 
-    if (const std::string warning = scene.kernel_warning(); !warning.empty())
+    if (const std::string warning = scene.kernel_warning(); !warning.empty()) {
         std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
+        summary.warnings.push_back(warning);
+    }
     if (!quiet) {
         const ParticleCounts& c = summary.particles;
         // Carving changes how much fluid a scene holds: say so where the counts are given.

@@ -215,6 +215,7 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;
     j["frames"] = run.frames;
+    j["warnings"] = run.warnings;
     j["scene"] = scene.resolved;
     // A path given on the command line may hold bytes that are not UTF-8: replaced, never fatal.
     const std::string text = j.dump(2, ' ', false, SceneJson::error_handler_t::replace) + "\n";

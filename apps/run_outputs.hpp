@@ -84,6 +84,7 @@ struct RunSummary {
     std::size_t device_bytes = 0;
     int frames = 0;
     std::string stop_condition;  // "steps N" or "time T s"
+    std::vector<std::string> warnings;  // about the scene, given before the run (Scene::kernel_warning)
 };
 
 void write_summary(const std::string& path, const RunSummary& summary, const StatsTable& stats, const Scene& scene);

@@ -286,6 +286,9 @@ TEST_CASE("info: the kernel, and a warning for the cubic spline at a support it 
                          scratch_dir() + "/wide");
     CHECK(r.code == 0);
     CHECK(contains(r.err, "pairing instability"));
+    const auto summary = nlohmann::json::parse(slurp(scratch_dir() + "/wide/summary.json"));
+    REQUIRE(summary["warnings"].size() == 1);
+    CHECK(contains(summary["warnings"][0].get<std::string>(), "pairing instability"));
 }
 
 TEST_CASE("bad input: a moving object that starts inside another object or a static box") {
