@@ -191,21 +191,30 @@ double available_host_bytes() {
 }
 }  // namespace
 
-void check_host_memory(const Scene& scene, const std::string& backend, bool host_layout) {
-    const double available = available_host_bytes();
-    if (available <= 0) return;
+double host_bytes_needed(const Scene& scene, const std::string& backend, bool host_layout) {
     // Peak host memory per particle, measured with /usr/bin/time on the 1M dam break (992k fluid,
-    // 568k wall particles; 2026-11-22, this project's 2-core VM): 459 MB building the OpenMP
-    // layout (neighbour lists), 277 MB the CUDA layout (grid gathers), which these figures
+    // 568k wall particles, h = 2 r0; 2026-11-22, this project's 2-core VM): 459 MB building the
+    // OpenMP layout (neighbour lists), 277 MB the CUDA layout (grid gathers), which these figures
     // reproduce within 2%. A GPU run keeps only the initial particles and frame buffers on the
-    // host (about 100 bytes per particle).
+    // host (about 100 bytes per particle). The lists' share (about 180 of the 420 bytes at
+    // h = 2 r0) grows with the neighbour count, (h / 2 r0)³: at 2.5 r0 the benchmark's lists case
+    // holds 691 bytes per fluid particle against 443 at 2 r0 (bench/results/...-session14-kernels.md).
     const ParticleEstimate n = estimate_particles(scene);
     const bool lists = scene.params.neighbor_lists == SimulationParams::Lists::kAuto
                            ? backend == "openmp"
                            : scene.params.neighbor_lists == SimulationParams::Lists::kOn;
-    const double fluid_bytes = !host_layout ? 100.0 : lists ? 420.0 : 240.0;
+    const double width = double(scene.params.fluid.support_radius) / (2.0 * double(scene.params.fluid.spacing));
+    const double list_bytes = 180.0 * width * width * width;
+    const double fluid_bytes = !host_layout ? 100.0 : lists ? 240.0 + list_bytes : 240.0;
     const double boundary_bytes = host_layout ? 60.0 : 100.0;
-    const double needed = n.fluid * fluid_bytes + n.boundary * boundary_bytes;
+    return n.fluid * fluid_bytes + n.boundary * boundary_bytes;
+}
+
+void check_host_memory(const Scene& scene, const std::string& backend, bool host_layout) {
+    const double available = available_host_bytes();
+    if (available <= 0) return;
+    const ParticleEstimate n = estimate_particles(scene);
+    const double needed = host_bytes_needed(scene, backend, host_layout);
     if (needed > available)
         throw DeviceError("the scene needs about " + format_bytes(needed) + " of host memory (" +
                           with_thousands(long(n.total())) + " particles before objects), but only " +

@@ -46,6 +46,8 @@ std::unique_ptr<Simulation> create_simulation(const SimulationSetup& setup, cons
 // the simulation runs on the host (openmp, or `info` measuring a layout there) rather than on a
 // GPU, where the host keeps only the initial particles and frame buffers.
 void check_host_memory(const Scene& scene, const std::string& backend, bool host_layout);
+// The estimate check_host_memory compares with the available memory, in bytes.
+double host_bytes_needed(const Scene& scene, const std::string& backend, bool host_layout);
 
 // Numeric options are declared as strings (cxxopts::value<std::string>()) and converted here, so
 // that a bad value is reported by its option's name in this program's words; cxxopts' own
