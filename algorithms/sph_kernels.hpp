@@ -3,7 +3,6 @@
 // scene chooses one (`fluid.kernel`, KernelKind below) and a new kernel is one more struct here.
 #pragma once
 #include <cmath>
-#include <string>
 #include <type_traits>
 
 #include "algorithms/vec3.hpp"
@@ -13,7 +12,8 @@ namespace mw {
 constexpr Real kPi = Real(3.14159265358979323846);
 
 // The scene's choice of smoothing kernel for the fluid (`fluid.kernel`).
-//  - cubic spline (Monaghan): the paper's and METHOD.md's kernel, the default.
+//  - cubic spline (Monaghan): METHOD.md's kernel (the paper says only "a Gaussian-like kernel
+//    with finite support radius h"), the default.
 //  - Wendland C2 (Wendland 1995): no pairing instability at any neighbour count (Dehnen & Aly
 //    2012). The cubic spline has one at wide supports: at the paper's h = 2.5 r0 (about 65
 //    neighbours) particles under a deep column's pressure close in pairs below h/3, where its
