@@ -73,7 +73,6 @@ struct RadialKernel {
 
 // Cubic spline (Monaghan) with compact support h: W > 0 for r < h. Normalised in 3D.
 struct CubicSpline3D : RadialKernel<CubicSpline3D> {
-    static constexpr KernelKind kind = KernelKind::kCubicSpline;
     Real sigma = 0;       // 8 / (π h³)
     Real grad_scale = 0;  // 48 / (π h⁴)
 
@@ -102,7 +101,6 @@ struct CubicSpline3D : RadialKernel<CubicSpline3D> {
 
 // Wendland C2 with compact support h, normalised in 3D: W = 21/(2π h³) (1-q)⁴ (1+4q).
 struct WendlandC2_3D : RadialKernel<WendlandC2_3D> {
-    static constexpr KernelKind kind = KernelKind::kWendlandC2;
     Real sigma = 0;       // 21 / (2π h³)
     Real grad_scale = 0;  // 20 σ / h = 210 / (2π h⁴)
 

@@ -112,7 +112,8 @@ int command_info(int argc, char** argv) {
                     double(f.support_radius / f.spacing), scene.static_boxes.size());
     else
         std::printf("boundary    no domain walls; %zu static box(es)\n", scene.static_boxes.size());
-    if (const std::string warning = scene.kernel_warning(); !warning.empty()) std::printf("warning     %s\n", warning.c_str());
+    if (const std::string warning = scene.kernel_warning(); !warning.empty())
+        std::printf("warning     %s\n", warning.c_str());
     return 0;
 }
 

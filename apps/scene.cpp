@@ -365,9 +365,10 @@ void read_fluid(Section s, Scene& scene) {
     const double r0 = s.number("spacing", std::nullopt, Range::positive());
     f.spacing = Real(r0);
     f.support_radius = Real(s.number("support_radius", 2 * r0, Range{r0, 4 * r0, true, false}));
-    f.kernel = s.choice("kernel", "cubic_spline", {"cubic_spline", "wendland_c2"}) == "wendland_c2"
-                   ? KernelKind::kWendlandC2
-                   : KernelKind::kCubicSpline;
+    // The names are kernel_name()'s, so the resolved scene and `info` spell them alike.
+    const std::string cubic = kernel_name(KernelKind::kCubicSpline), wendland = kernel_name(KernelKind::kWendlandC2);
+    f.kernel = s.choice("kernel", cubic, {cubic, wendland}) == wendland ? KernelKind::kWendlandC2
+                                                                        : KernelKind::kCubicSpline;
     f.viscosity = Real(s.number("viscosity", 0.0, Range::non_negative()));
     f.wall_viscosity = Real(s.number("wall_viscosity", 0.0, Range::non_negative()));
     s.finish();

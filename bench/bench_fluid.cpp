@@ -259,10 +259,12 @@ int main(int argc, char** argv) {
             for (const char* spacing : {"0.05", "0.025"}) {
                 // A block of edge 1 m - r0 holds the peer's counts: 19³ = 6,859 and 39³ = 59,319.
                 const double r0 = std::atof(spacing), edge = 1.0 - r0;
-                const std::string corner = "[" + std::to_string(edge) + "," + std::to_string(edge) + "," + std::to_string(edge) + "]";
+                const std::string side = std::to_string(edge);
+                const std::string corner = "[" + side + "," + side + "," + side + "]";
                 const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/splishsplash_block.json",
                                                {std::string("fluid.spacing=") + spacing,
-                                                "fluid.support_radius=" + std::to_string(2 * r0), "fluid_blocks.0.max=" + corner});
+                                                "fluid.support_radius=" + std::to_string(2 * r0),
+                                                "fluid_blocks.0.max=" + corner});
                 // The whole collapse of the block: 1 s of simulated time (300 steps with --quick).
                 const int steps = o.quick ? 300 : 1000;
                 const int case_steps = std::string(spacing) == "0.05" ? steps : steps / 4;

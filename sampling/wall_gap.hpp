@@ -6,9 +6,9 @@ namespace mw {
 
 // The distance outside the domain faces, in metres, at which the first Akinci layer of the domain
 // walls (then `layers` layers `boundary_spacing` apart, each a square grid of that spacing) gives a
-// fluid layer r0/2 inside a face exactly the rest density, for the solver's kernel of support h
-// (`kernel`) and its fluid mass (a full lattice at spacing r0 has the rest density). Fluid blocks fill the
-// domain from r0/2 inside its faces, so they then start at rest next to the walls.
+// fluid layer r0/2 inside a face exactly the rest density, for the solver's kernel (`kernel`) of
+// support h and its fluid mass (a full lattice at spacing r0 has the rest density). Fluid blocks
+// fill the domain from r0/2 inside its faces, so they then start at rest next to the walls.
 //
 // Why it is computed and not a constant: a wall layer stands for the fluid missing beyond the
 // face, and how much of it one sheet of particles represents depends on h/r0, on the spacing and

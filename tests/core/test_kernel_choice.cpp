@@ -30,8 +30,8 @@ struct CollapseRun {
 // the collapse moves at about 1 m/s then. Stops early once a particle is thrown (20 m/s).
 CollapseRun collapse(KernelKind kernel) {
     const Real r0 = 0.02f;
-    SimulationSetup setup =
-        test::fluid_in_box({0, 0, 0}, {1.6f, 1.0f, 0.8f}, {0, 0, 0}, {0.6f, 0.8f, 0.8f}, r0, 0.0015f, true, 2.5f, kernel);
+    SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {1.6f, 1.0f, 0.8f}, {0, 0, 0}, {0.6f, 0.8f, 0.8f}, r0,
+                                               0.0015f, true, 2.5f, kernel);
     setup.params.solver.dt_mode = TimeStepMode::kCfl;
     setup.params.solver.eta_max = Real(default_eta_max(setup.params.solver.eta));
     auto sim = create_openmp_simulation(setup, 0);

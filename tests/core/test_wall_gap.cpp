@@ -61,7 +61,9 @@ StartDensities start_densities_with(const Kernel& kernel, Real r0, Real boundary
 }
 StartDensities start_densities(Real r0, Real h, Real boundary_spacing, int layers, Real gap,
                                KernelKind kind = kCubic) {
-    return with_kernel(kind, h, [&](const auto& kernel) { return start_densities_with(kernel, r0, boundary_spacing, layers, gap); });
+    return with_kernel(kind, h, [&](const auto& kernel) {
+        return start_densities_with(kernel, r0, boundary_spacing, layers, gap);
+    });
 }
 }  // namespace
 
@@ -95,7 +97,8 @@ TEST_CASE("the domain walls' gap starts fluid next to a face at rest density, fo
         const Real h = Real(c.support) * r0, spacing = Real(c.spacing) * r0;
         const Real gap = rest_density_wall_gap(r0, h, spacing, c.layers, c.kernel);
         const StartDensities d = start_densities(r0, h, spacing, c.layers, gap, c.kernel);
-        MESSAGE(std::string(kernel_name(c.kernel)) << ", h " << c.support << " r0, walls " << c.layers << " x " << c.spacing << " r0: gap " << gap / r0
+        MESSAGE(std::string(kernel_name(c.kernel)) << ", h " << c.support << " r0, walls " << c.layers << " x "
+                                                   << c.spacing << " r0: gap " << gap / r0
                      << " r0; face " << d.face_lo << ".." << d.face_hi << ", edge up to " << d.edge_hi
                      << ", corner " << d.corner_hi << ", interior " << d.interior_lo << ".." << d.interior_hi);
         // The interior is at rest by the mass; the layer next to a flat face by the gap (measured
