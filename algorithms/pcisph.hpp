@@ -9,6 +9,7 @@
 #pragma once
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/sph_kernels.hpp"
+#include "algorithms/wall_contact.hpp"
 #include "algorithms/wall_mirror.hpp"
 
 MW_BACKEND_BEGIN
@@ -97,15 +98,17 @@ void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count
     });
 }
 
-// x*_i = x_i + Δt (v_i + Δt (a_np + a_p)). Without a non-pressure field, a_np is gravity.
-// A null pressure_acc means no pressure acceleration yet.
+// x*_i = x_i + Δt v*_i with v*_i = v_i + Δt (a_np + a_p), then the walls' position rule
+// (wall_contact.hpp). Without a non-pressure field, a_np is gravity. A null pressure_acc means no
+// pressure acceleration yet.
 inline void predict_positions(std::size_t fluid_count, View<const Vec3> position, View<const Vec3> velocity,
                               const Vec3* nonpressure, const Vec3* pressure_acc, View<Vec3> predicted, Vec3 gravity,
-                              Real dt) {
+                              Real dt, WallContact walls) {
     parallel_for("pcisph_predict", fluid_count, [=] MW_HD(std::size_t i) {
         Vec3 a = nonpressure ? nonpressure[i] : gravity;
         if (pressure_acc) a += pressure_acc[i];
-        predicted[i] = position[i] + dt * (velocity[i] + dt * a);
+        const Vec3 v = velocity[i] + dt * a;
+        predicted[i] = walls.correct_predicted(position[i] + dt * v, v);
     });
 }
 
@@ -165,14 +168,17 @@ void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<co
     });
 }
 
-// Symplectic Euler: v += Δt (a_np + a_p); x += Δt v.
+// Symplectic Euler: v += Δt (a_np + a_p); x += Δt v; then the velocity–position correction
+// against the domain walls (wall_contact.hpp).
 inline void integrate_fluid(std::size_t fluid_count, View<Vec3> position, View<Vec3> velocity, const Vec3* nonpressure,
-                            View<const Vec3> pressure_acc, Vec3 gravity, Real dt) {
+                            View<const Vec3> pressure_acc, Vec3 gravity, Real dt, WallContact walls) {
     parallel_for("integrate_fluid", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 a = (nonpressure ? nonpressure[i] : gravity) + pressure_acc[i];
-        const Vec3 v = velocity[i] + dt * a;
+        Vec3 v = velocity[i] + dt * a;
+        Vec3 x = position[i] + dt * v;
+        walls.correct(x, v);
         velocity[i] = v;
-        position[i] = position[i] + dt * v;
+        position[i] = x;
     });
 }
 

@@ -54,6 +54,12 @@ struct SimulationParams {
     // Whether the domain's faces are lined with static wall particles (the scenes' boundary.walls).
     // Then they are free-slip walls, and Eq. 4 next to them sums over the fluid's mirror images too.
     bool domain_walls = false;
+    // How far outside the faces the walls' first particle layer lies (sampling/wall_gap.hpp), m;
+    // negative: not given. Needed with domain_walls when wall_correction is on.
+    Real wall_gap = -1;
+    // The velocity–position correction against the domain walls (algorithms/wall_contact.hpp):
+    // fluid moving outward never comes closer than r0 to their first layer.
+    bool wall_correction = true;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

@@ -110,7 +110,7 @@ class BackendSimulation final : public Simulation {
         if (has_fluid_) {
             timers_.start(kIntegrate);
             integrate_fluid(fluid_count, store_.position.view(), store_.velocity.view(), nonpressure,
-                            pressure_acc_.cview(), fluid_.gravity, dt);
+                            pressure_acc_.cview(), fluid_.gravity, dt, wall_contact_);
             motion = summarize_motion(fluid_count, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
             timers_.stop(kIntegrate);
         }
@@ -170,7 +170,8 @@ class BackendSimulation final : public Simulation {
             // The first prediction has no pressure acceleration yet (nothing to clear beforehand).
             const bool first = iterations == 0;
             predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
-                              first ? nullptr : pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt);
+                              first ? nullptr : pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt,
+                              wall_contact_);
             predict_density_and_pressure(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
                                          boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
                                          pressure_term_.view(), fluid_, delta, first);
@@ -246,6 +247,7 @@ class BackendSimulation final : public Simulation {
     NeighborGrid grid_;
     NeighborList lists_;
     bool use_lists_ = false;
+    WallContact wall_contact_;  // the velocity–position correction against the domain walls (inactive: none)
     DeviceArray<std::uint32_t>* neighbor_count_ = nullptr;  // store field: each particle's list length, sizes next step's row
     GroupRanges ranges_;
     DeviceArray<Real> boundary_volume_;  // V_b, indexed like the store (fluid entries unused)
@@ -328,6 +330,11 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     fluid_.viscosity = fp.viscosity;
     fluid_.wall_viscosity = fp.wall_viscosity;
     fluid_.gravity = params_.gravity;
+    if (params_.domain_walls && params_.wall_correction) {
+        if (!(params_.wall_gap >= 0))
+            throw InputError("simulation setup: the domain walls' correction needs the walls' gap (params.wall_gap)");
+        wall_contact_ = WallContact::for_domain(params_.domain_min, params_.domain_max, params_.wall_gap, fp.spacing);
+    }
     if (params_.domain_walls && fp.viscosity > 0)
         fluid_.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::kAllFaces, h};
     // Mass such that the prototype lattice at spacing r0 has exactly the rest density.

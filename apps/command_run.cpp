@@ -61,6 +61,16 @@ std::string lost_fluid_message(const StepReport& r, long fluid_count, long diver
                                              "and stats.csv)"));
 }
 
+std::string density_blowup_message(const StepReport& r, long diverged_steps, const Scene& scene) {
+    char head[200];
+    std::snprintf(head, sizeof head, "step %ld (t = %.6g s): the fluid is packed %.3g%% above its rest density, more than ",
+                  r.step, r.time, 100.0 * r.density_error_max);
+    return head + ("solver.max_density_error " + format_number(scene.max_density_error)) +
+           (diverged_steps > 0 ? "; PCISPH diverged in " + count_of(diverged_steps, "step") +
+                                     " so far (column diverged of stats.csv): use a smaller dt, or dt_mode \"cfl\""
+                               : std::string("; the run blew up (see the last frames and stats.csv)"));
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -220,6 +230,10 @@ int command_run(int argc, char** argv) {
             if (r.lost_particles > scene.max_lost_fraction * double(summary.particles.by_type[kFluid])) {
                 progress.finish();
                 throw SimulationError(lost_fluid_message(r, summary.particles.by_type[kFluid], stats.diverged_steps(), scene));
+            }
+            if (r.density_error_max > scene.max_density_error) {
+                progress.finish();
+                throw SimulationError(density_blowup_message(r, stats.diverged_steps(), scene));
             }
             if (r.time >= next_frame_time * (1 - 1e-9)) {
                 write_frame();

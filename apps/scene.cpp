@@ -384,6 +384,7 @@ void read_solver(Section s, Scene& scene) {
     p.eta = Real(eta);
     p.eta_max = Real(s.number("eta_max", default_eta_max(eta), Range{0, 1, false, true}));
     p.min_iterations = s.integer("min_iterations", 3, 1, 1000);
+    scene.max_density_error = s.number("max_density_error", 1.0, Range::positive());
     p.max_iterations = s.integer("max_iterations", 100, 1, 10000);
     if (p.max_iterations < p.min_iterations)
         s.fail(s.key_path("max_iterations"), "must be >= min_iterations (" + std::to_string(p.min_iterations) +
@@ -395,6 +396,7 @@ void read_boundary(Section s, Scene& scene) {
     scene.walls = s.boolean("walls", true);
     scene.boundary_spacing_factor = Real(s.number("spacing_factor", 0.5, Range{0, 1, true, false}));
     scene.boundary_layers = s.integer("layers", 1, 1, 8);
+    scene.params.wall_correction = s.boolean("correction", true);
     scene.max_lost_fraction = s.number("max_lost_fraction", scene.walls ? 0.01 : 1.0, Range{0, 1});
     s.finish();
 }

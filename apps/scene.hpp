@@ -54,6 +54,10 @@ struct Scene {
     // left the domain. With walls a loss means a leak or a blow-up, so the default is 1%; an open
     // domain (walls false) lets fluid out by design, so there it defaults to 1 (never stop).
     double max_lost_fraction = 0.01;
+    // solver.max_density_error: the run stops (exit 4) at the first step that ends with a peak
+    // density error above this. Since the walls' correction keeps the fluid inside them, a
+    // blow-up no longer shows as lost fluid; it shows as fluid packed far above its rest density.
+    double max_density_error = 1.0;
     std::vector<FluidBlock> fluid_blocks;
     std::vector<StaticBox> static_boxes;
     std::vector<SceneObject> objects;

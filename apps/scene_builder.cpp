@@ -167,6 +167,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     }
     const Real rb = scene.boundary_spacing();
     setup.params.domain_walls = scene.walls;
+    setup.params.wall_gap = scene.walls ? scene.wall_gap() : Real(-1);
     if (scene.walls)
         // The first layer where fluid blocks touching a wall start at rest density (wall_gap.hpp).
         append(setup,
