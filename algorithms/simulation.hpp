@@ -10,6 +10,7 @@
 #include "algorithms/particle_types.hpp"
 #include "algorithms/sph_kernels.hpp"
 #include "algorithms/vec3.hpp"
+#include "algorithms/wall_contact.hpp"
 
 namespace mw {
 
@@ -57,9 +58,12 @@ struct SimulationParams {
     // How far outside the faces the walls' first particle layer lies (sampling/wall_gap.hpp), m;
     // negative: not given. Needed with domain_walls when wall_correction is on.
     Real wall_gap = -1;
-    // The velocity–position correction against the domain walls (algorithms/wall_contact.hpp):
-    // fluid moving outward never comes closer than r0 to their first layer.
+    // The velocity–position correction against the domain walls and the static boxes
+    // (algorithms/wall_contact.hpp): fluid moving into them never comes closer than r0 to their
+    // first layer.
     bool wall_correction = true;
+    // The static boxes' faces, for that correction (their particles are in the setup's lists).
+    std::vector<ContactBox> static_boxes;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

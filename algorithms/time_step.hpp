@@ -143,7 +143,7 @@ class BackendSimulation final : public Simulation {
     // sort's buffers, sized by the largest sort of the process so far).
     std::size_t device_bytes() const override {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
-               pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
+               pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() + contact_boxes_.bytes() +
                backend_scratch_bytes();
     }
     double time() const override { return time_; }
@@ -247,7 +247,8 @@ class BackendSimulation final : public Simulation {
     NeighborGrid grid_;
     NeighborList lists_;
     bool use_lists_ = false;
-    WallContact wall_contact_;  // the velocity–position correction against the domain walls (inactive: none)
+    WallContact wall_contact_;  // the velocity–position correction against the domain walls and static boxes
+    DeviceArray<ContactBox> contact_boxes_;  // the static boxes' faces, read by wall_contact_
     DeviceArray<std::uint32_t>* neighbor_count_ = nullptr;  // store field: each particle's list length, sizes next step's row
     GroupRanges ranges_;
     DeviceArray<Real> boundary_volume_;  // V_b, indexed like the store (fluid entries unused)
@@ -334,6 +335,11 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
         if (!(params_.wall_gap >= 0))
             throw InputError("simulation setup: the domain walls' correction needs the walls' gap (params.wall_gap)");
         wall_contact_ = WallContact::for_domain(params_.domain_min, params_.domain_max, params_.wall_gap, fp.spacing);
+    }
+    if (params_.wall_correction && !params_.static_boxes.empty() && counts_.by_type[kFluid] > 0) {
+        contact_boxes_.upload(params_.static_boxes);
+        wall_contact_.boxes = contact_boxes_.cview();
+        wall_contact_.box_contact = fp.spacing;
     }
     if (params_.domain_walls && fp.viscosity > 0)
         fluid_.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::kAllFaces, h};

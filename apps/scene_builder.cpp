@@ -178,6 +178,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     std::vector<Eigen::AlignedBox3d> boxes;
     for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
         const StaticBox& b = scene.static_boxes[i];
+        setup.params.static_boxes.push_back(ContactBox{b.min, b.max});
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
                static_cast<std::int32_t>(i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));

@@ -9,6 +9,7 @@
 
 #include "algorithms/wall_contact.hpp"
 #include "backend/backend_registry.hpp"
+#include "sampling/box_particles.hpp"
 #include "sampling/wall_gap.hpp"
 #include "test_setups.hpp"
 
@@ -85,22 +86,90 @@ TEST_CASE("wall contact: a fluid block touching a face starts on or beyond the p
             }
 }
 
+TEST_CASE("wall contact: static boxes, with a band rounded at their edges") {
+    const Real r0 = 0.02f;
+    const ContactBox box{{0.4f, 0, 0.4f}, {0.6f, 0.2f, 0.6f}};
+    WallContact contact;  // no domain walls: the box alone
+    contact.boxes = View<const ContactBox>{&box, 1};
+    contact.box_contact = r0;
+
+    SUBCASE("above the top face, falling: back to r0 above it, the normal speed gone") {
+        Vec3 x{0.5f, Real(0.2) + Real(0.3) * r0, 0.5f}, v{1, -4, 0};
+        contact.correct(x, v);
+        CHECK(x.y == doctest::Approx(0.2 + r0));
+        CHECK(v.y == doctest::Approx(0).epsilon(1e-6));
+        CHECK(v.x == doctest::Approx(1));
+        CHECK(x.x == doctest::Approx(0.5));
+    }
+    SUBCASE("beside an edge, moving at it: put r0 from the edge along the diagonal") {
+        const Real s = Real(0.5) * r0;  // 0.71 r0 from the top edge at x = 0.6, y = 0.2
+        Vec3 x{Real(0.6) + s, Real(0.2) + s, 0.5f}, v{-1, -1, 0.5f};
+        contact.correct(x, v);
+        const Real off = r0 / std::sqrt(Real(2));
+        CHECK(x.x == doctest::Approx(0.6 + off));
+        CHECK(x.y == doctest::Approx(0.2 + off));
+        CHECK(v.x == doctest::Approx(0).epsilon(1e-6));
+        CHECK(v.y == doctest::Approx(0).epsilon(1e-6));
+        CHECK(v.z == doctest::Approx(0.5));
+    }
+    SUBCASE("off the edge by more than r0, though within r0 of both faces' planes: untouched") {
+        const Real s = Real(0.8) * r0;  // 1.13 r0 from the edge
+        Vec3 x{Real(0.6) + s, Real(0.2) + s, 0.5f}, v{-1, -1, 0};
+        contact.correct(x, v);
+        CHECK(x.x == doctest::Approx(0.6 + s));
+        CHECK(v.x == doctest::Approx(-1));
+    }
+    SUBCASE("inside the box: out through the nearest face") {
+        Vec3 x{0.5f, Real(0.2) - Real(0.2) * r0, 0.45f}, v{0, -3, 0};
+        contact.correct(x, v);
+        CHECK(x.y == doctest::Approx(0.2 + r0));
+        CHECK(v.y == doctest::Approx(0).epsilon(1e-6));
+    }
+    SUBCASE("near the box but leaving it: untouched") {
+        Vec3 x{0.5f, Real(0.2) + Real(0.3) * r0, 0.5f}, v{0, 2, 0};
+        contact.correct(x, v);
+        CHECK(x.y == doctest::Approx(0.2 + 0.3 * r0));
+        CHECK(v.y == doctest::Approx(2));
+    }
+}
+
 namespace {
 
 struct Impact {
     long lost = 0;
-    Real lowest = 1e30f;        // the lowest x of any fluid particle, over every step
+    Real lowest = 1e30f;        // the closest any fluid particle came to the wall (or box), over every step
     double energy_ratio = 0;    // largest kinetic energy after the first step over the first's
 };
 
 // A 0.12 m cube of fluid at 20 m/s towards the x = 0 wall of a 0.6 m box, at a fixed 2 ms: two
-// particle spacings a step, ten times what one Akinci layer stops within a step.
-Impact drive_into_wall(bool correction) {
+// particle spacings a step, ten times what one Akinci layer stops within a step. With
+// `static_box`, the cube is aimed instead at a static box (one layer) 0.1 m in front of that wall.
+Impact drive_into_wall(bool correction, bool static_box = false) {
     const Real r0 = 0.02f;
-    SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.6f, 0.6f, 0.6f}, {0.1f, 0.1f, 0.24f},
-                                               {0.22f, 0.22f, 0.36f}, r0, 0.002f);
+    const Vec3 lo = static_box ? Vec3{0.3f, 0.1f, 0.24f} : Vec3{0.1f, 0.1f, 0.24f};
+    SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.6f, 0.6f, 0.6f}, lo,
+                                               lo + Vec3{0.12f, 0.12f, 0.12f}, r0, 0.002f);
     setup.params.gravity = {0, 0, 0};
     setup.params.wall_correction = correction;
+    if (static_box) {
+        const ContactBox box{{0.1f, 0.02f, 0.1f}, {0.2f, 0.3f, 0.5f}};
+        for (const Vec3& p : sample_solid_box(box.lo, box.hi, r0 / 2, 1)) {
+            setup.position.push_back(p);
+            setup.velocity.push_back(Vec3{0, 0, 0});
+            setup.type.push_back(kStaticBoundary);
+            setup.object.push_back(0);
+        }
+        setup.params.static_boxes.push_back(box);
+    }
+    // How far a particle is from the face the cube is driven at, the wall's (x = 0), or from the
+    // box (0 inside it: the fluid also flows round the box, past its far side).
+    const ContactBox target = static_box ? setup.params.static_boxes[0] : ContactBox{};
+    auto clearance = [&](Vec3 x) {
+        if (!static_box) return x.x;
+        const Vec3 q{std::clamp(x.x, target.lo.x, target.hi.x), std::clamp(x.y, target.lo.y, target.hi.y),
+                     std::clamp(x.z, target.lo.z, target.hi.z)};
+        return norm(x - q);
+    };
     for (std::size_t i = 0; i < setup.type.size(); ++i)
         if (setup.type[i] == kFluid) setup.velocity[i] = Vec3{-20, 0, 0};
     auto sim = create_openmp_simulation(setup, 0);
@@ -116,9 +185,10 @@ Impact drive_into_wall(bool correction) {
         sim->download(particles);
         for (std::size_t i = 0; i < particles.type.size(); ++i)
             if (particles.type[i] == kFluid && std::isfinite(particles.position[i].x))
-                impact.lowest = std::min(impact.lowest, particles.position[i].x);
+                impact.lowest = std::min(impact.lowest, clearance(particles.position[i]));
     }
-    MESSAGE("correction " << std::string(correction ? "on" : "off") << ": " << impact.lost << " lost, lowest x "
+    MESSAGE(std::string(static_box ? "static box" : "domain wall") << ", correction "
+            << std::string(correction ? "on" : "off") << ": " << impact.lost << " lost, closest "
                           << impact.lowest / r0 << " r0, largest kinetic energy / first step's " << impact.energy_ratio);
     return impact;
 }
@@ -137,4 +207,20 @@ TEST_CASE("wall contact: a block driven into a wall at 20 m/s stays inside with 
     CHECK(with.lowest < Real(0.41) * r0);  // and some did reach the plane
     // The normal rule is inelastic: the impact takes energy out and never puts any in.
     CHECK(with.energy_ratio <= 1.0 + 1e-6);
+}
+
+TEST_CASE("wall contact: a block driven into a static box at 20 m/s stays out of it with the correction") {
+    const Real r0 = 0.02f;
+    const Impact without = drive_into_wall(false, true);
+    CHECK(without.lowest == 0);  // a particle got inside the box, past its layer
+    const Impact with = drive_into_wall(true, true);
+    CHECK(with.lost == 0);
+    // Never inside, nor near the layer: the rule acts on where a step ends, and a particle that
+    // passes an edge in a straight step can end within r0 of it already moving away, which the
+    // rule leaves alone (measured: 0.89 r0 at the closest).
+    CHECK(with.lowest > Real(0.5) * r0);
+    CHECK(with.lowest < Real(1.01) * r0);
+    // Not asserted: the kinetic energy. The fluid squirts round the box's edges at this step
+    // (two spacings a step), and PCISPH then gains energy with the correction or without it
+    // (measured: 5% and 45% over the first step's).
 }
