@@ -291,6 +291,22 @@ TEST_CASE("info: the kernel, and a warning for the cubic spline at a support it 
     CHECK(contains(summary["warnings"][0].get<std::string>(), "pairing instability"));
 }
 
+TEST_CASE("info: the walls' velocity-position correction, on by default, named with what it covers") {
+    const Result on = run("info");
+    REQUIRE(on.code == 0);
+    CHECK(contains(on.out, "velocity-position correction on (boundary.correction): fluid moving into the walls stops"));
+    const Result boxes = run("info --set boundary.walls=false --set 'static_boxes=[{\"min\":[1,0,0.3],\"max\":[1.2,0.2,0.5]}]'");
+    REQUIRE(boxes.code == 0);
+    CHECK(contains(boxes.out, "fluid moving into the static boxes stops"));
+    const Result off = run("info --set boundary.correction=false");
+    REQUIRE(off.code == 0);
+    CHECK(contains(off.out, "velocity-position correction off"));
+    const Result open = run("info --set boundary.walls=false");
+    REQUIRE(open.code == 0);
+    CHECK(!contains(open.out, "velocity-position correction"));  // nothing to correct against
+    check_rejected(run("info --set boundary.correction=1"), {"boundary.correction"});
+}
+
 TEST_CASE("bad input: a moving object that starts inside another object or a static box") {
     // 0.04 m cubes at r0 = 0.02 m: 2 x 2 x 2 inner particles, 0.01 m inside each face.
     const auto cube = [](const std::string& kind, double x) {
