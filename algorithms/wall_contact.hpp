@@ -24,6 +24,8 @@
 // is right there as it is. Near a box's edges and corners the band is rounded (distance to the
 // box, not to its faces' planes), so fluid flowing round an edge is not pushed off it.
 #pragma once
+#include <limits>
+
 #include "algorithms/vec3.hpp"
 #include "backend/view.hpp"
 
@@ -35,9 +37,11 @@ struct ContactBox {
 };
 
 struct WallContact {
+    static constexpr Real kFar = std::numeric_limits<Real>::max();
     // The planes the fluid may not cross moving outward: the wall layers moved in by `contact`.
-    Vec3 lo{0, 0, 0}, hi{0, 0, 0};
-    bool active = false;
+    // Without domain walls they lie at the largest finite values, where no test passes, so that
+    // the hot loops need no branch on whether there are walls.
+    Vec3 lo{-kFar, -kFar, -kFar}, hi{kFar, kFar, kFar};
     // Static boxes (in backend memory), kept box_contact from.
     View<const ContactBox> boxes;
     Real box_contact = 0;
@@ -50,17 +54,14 @@ struct WallContact {
         WallContact c;
         c.lo = Vec3{domain_lo.x + inward, domain_lo.y + inward, domain_lo.z + inward};
         c.hi = Vec3{domain_hi.x - inward, domain_hi.y - inward, domain_hi.z - inward};
-        c.active = true;
         return c;
     }
 
     // After integration: the position back to the plane, the velocity into the wall removed.
     MW_INLINE void correct(Vec3& x, Vec3& v) const {
-        if (active) {
-            axis(x.x, v.x, lo.x, hi.x);
-            axis(x.y, v.y, lo.y, hi.y);
-            axis(x.z, v.z, lo.z, hi.z);
-        }
+        axis(x.x, v.x, lo.x, hi.x);
+        axis(x.y, v.y, lo.y, hi.y);
+        axis(x.z, v.z, lo.z, hi.z);
         for (std::size_t b = 0; b < boxes.size(); ++b) box(x, v, boxes[b], box_contact);
     }
 
@@ -105,14 +106,16 @@ struct WallContact {
     static MW_INLINE Real clamp(Real x, Real lo_value, Real hi_value) {
         return x < lo_value ? lo_value : (x > hi_value ? hi_value : x);
     }
+    // Selects, not branches: every fluid particle goes through this in the prediction and the
+    // integration, and branches kept those loops from vectorizing (measured on the default dam
+    // break, 300 steps, 2 threads: the integration stage took 0.33 ms with branches, 0.17 ms
+    // with selects, 0.10 ms before the correction existed; PCISPH 12.4-12.8 ms with branches,
+    // 11.7-12.3 either way with selects).
     static MW_INLINE void axis(Real& x, Real& v, Real lo_plane, Real hi_plane) {
-        if (x < lo_plane && v < Real(0)) {
-            x = lo_plane;
-            v = Real(0);
-        } else if (x > hi_plane && v > Real(0)) {
-            x = hi_plane;
-            v = Real(0);
-        }
+        const bool below = x < lo_plane && v < Real(0);
+        const bool above = x > hi_plane && v > Real(0);
+        x = below ? lo_plane : (above ? hi_plane : x);
+        v = (below || above) ? Real(0) : v;
     }
 };
 
