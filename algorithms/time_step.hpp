@@ -339,7 +339,6 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (params_.wall_correction && !params_.static_boxes.empty() && counts_.by_type[kFluid] > 0) {
         contact_boxes_.upload(params_.static_boxes);
         wall_contact_.boxes = contact_boxes_.cview();
-        wall_contact_.box_contact = fp.spacing;
     }
     if (params_.domain_walls && fp.viscosity > 0)
         fluid_.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::kAllFaces, h};

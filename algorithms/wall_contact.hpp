@@ -17,12 +17,16 @@
 // position is corrected, so the density the pressure answers is never that of a particle behind
 // the wall.
 //
-// `contact` is the paper's r0. For the domain walls it is never more than the distance at which
-// fluid next to a face starts at rest (the gap plus r0/2: 1.1 r0 with one layer and h = 2 r0,
-// 0.975 r0 with two), so a resting fluid block never starts inside the band. A static box's first
-// layer lies on its faces and the scene builder keeps fluid kFluidClearance = r0 from it, so r0
-// is right there as it is. Near a box's edges and corners the band is rounded (distance to the
-// box, not to its faces' planes), so fluid flowing round an edge is not pushed off it.
+// The distance: the paper's r0, but always at least 0.1 r0 short of where the fluid next to the
+// boundary rests (its rest distance less 0.1 r0, the slack the default walls have: one layer at
+// h = 2 r0 rests at 1.1 r0), so resting fluid is not held on the band's edge by rounding and
+// hydrostatic compression. Domain walls: the rest distance is the gap plus r0/2 (fluid blocks
+// start r0/2 inside the faces), so the band is r0 for one layer and 0.875 r0 for two. Static
+// boxes: their first layer lies on their faces, so the rest distance is the same for the same
+// layers, and the band is also kept inside the distance at which the scene builder's carve can
+// leave fluid (contact_distances()). Near a box's edges and corners the band is rounded (the
+// distance to the box, not to its faces' planes), so fluid flowing round an edge is not pushed
+// off it.
 #pragma once
 #include <limits>
 
@@ -31,10 +35,19 @@
 
 namespace mw {
 
-// A static box's faces: its first boundary layer lies on them (sampling/box_particles.hpp).
+// A static box's faces (its first boundary layer lies on them, sampling/box_particles.hpp), and
+// how far from the box fluid moving into it is stopped.
 struct ContactBox {
     Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+    Real contact = 0;
 };
+
+// The band's width for a boundary whose fluid rests `rest` from its first layer: r0, at most
+// rest - 0.1 r0.
+inline Real contact_distance(Real rest, Real r0) {
+    const Real short_of_rest = rest - Real(0.1) * r0;
+    return r0 < short_of_rest ? r0 : short_of_rest;
+}
 
 struct WallContact {
     static constexpr Real kFar = std::numeric_limits<Real>::max();
@@ -42,14 +55,12 @@ struct WallContact {
     // Without domain walls they lie at the largest finite values, where no test passes, so that
     // the hot loops need no branch on whether there are walls.
     Vec3 lo{-kFar, -kFar, -kFar}, hi{kFar, kFar, kFar};
-    // Static boxes (in backend memory), kept box_contact from.
+    // Static boxes (in backend memory).
     View<const ContactBox> boxes;
-    Real box_contact = 0;
 
     // For a domain [domain_lo, domain_hi] whose walls' first layer lies `gap` outside the faces.
     static WallContact for_domain(Vec3 domain_lo, Vec3 domain_hi, Real gap, Real r0) {
-        const Real rest = gap + r0 / 2;
-        const Real contact = r0 < rest ? r0 : rest;
+        const Real contact = contact_distance(gap + r0 / 2, r0);
         const Real inward = contact - gap;  // from the face into the domain (negative: outside it)
         WallContact c;
         c.lo = Vec3{domain_lo.x + inward, domain_lo.y + inward, domain_lo.z + inward};
@@ -57,12 +68,14 @@ struct WallContact {
         return c;
     }
 
-    // After integration: the position back to the plane, the velocity into the wall removed.
+    // After integration: the position back to the band's edge, the velocity into the boundary
+    // removed. The boxes first, the walls last: a particle pushed out of a box that stands on the
+    // floor must not end up beyond the floor's layer. Non-finite values are left to the guard.
     MW_INLINE void correct(Vec3& x, Vec3& v) const {
+        for (std::size_t b = 0; b < boxes.size(); ++b) box(x, v, boxes[b]);
         axis(x.x, v.x, lo.x, hi.x);
         axis(x.y, v.y, lo.y, hi.y);
         axis(x.z, v.z, lo.z, hi.z);
-        for (std::size_t b = 0; b < boxes.size(); ++b) box(x, v, boxes[b], box_contact);
     }
 
     // Inside PCISPH: the predicted position x* of a particle whose predicted velocity v* moves it
@@ -74,17 +87,19 @@ struct WallContact {
 
     // One static box: the nearest point q of the box to x; within `contact` of it and moving
     // towards it, x goes to q + contact n along n = (x - q)/|x - q| and v loses its part along
-    // -n. A particle already inside the box (q = x) leaves through its nearest face.
-    static MW_INLINE void box(Vec3& x, Vec3& v, const ContactBox& b, Real contact) {
+    // -n. A particle inside the box (q = x), which is never right, leaves through its nearest
+    // face whichever way it moves, losing any velocity into that face.
+    static MW_INLINE void box(Vec3& x, Vec3& v, const ContactBox& b) {
         const Vec3 q{clamp(x.x, b.lo.x, b.hi.x), clamp(x.y, b.lo.y, b.hi.y), clamp(x.z, b.lo.z, b.hi.z)};
         const Vec3 d = x - q;
         const Real d2 = norm2(d);
-        if (!(d2 < contact * contact)) return;  // the common case (and NaN: left to the guard)
+        if (!(d2 < b.contact * b.contact) || !is_finite(x) || !is_finite(v)) return;  // the common case
         Vec3 n, surface = q;
-        if (d2 > Real(0)) {
+        const bool inside = !(d2 > Real(0));
+        if (!inside) {
             n = (Real(1) / std::sqrt(d2)) * d;
         } else {
-            // Inside: the face nearest to x, by axis and side.
+            // The face nearest to x, by axis and side.
             const Real depth[6] = {x.x - b.lo.x, b.hi.x - x.x, x.y - b.lo.y, b.hi.y - x.y, x.z - b.lo.z, b.hi.z - x.z};
             int face = 0;
             for (int f = 1; f < 6; ++f)
@@ -97,9 +112,9 @@ struct WallContact {
             if (axis_index == 2) surface.z = (face & 1) ? b.hi.z : b.lo.z;
         }
         const Real vn = dot(v, n);
-        if (!(vn < Real(0))) return;  // leaving the box
-        x = surface + contact * n;
-        v = v - vn * n;
+        if (!inside && !(vn < Real(0))) return;  // in the band but leaving the box
+        x = surface + b.contact * n;
+        if (vn < Real(0)) v = v - vn * n;
     }
 
    private:
@@ -112,8 +127,10 @@ struct WallContact {
     // with selects, 0.10 ms before the correction existed; PCISPH 12.4-12.8 ms with branches,
     // 11.7-12.3 either way with selects).
     static MW_INLINE void axis(Real& x, Real& v, Real lo_plane, Real hi_plane) {
-        const bool below = x < lo_plane && v < Real(0);
-        const bool above = x > hi_plane && v > Real(0);
+        // -kFar <= x and v <= kFar keep an infinite position or velocity for the guard (NaN fails
+        // every test by itself).
+        const bool below = x < lo_plane && v < Real(0) && x >= -kFar && v >= -kFar;
+        const bool above = x > hi_plane && v > Real(0) && x <= kFar && v <= kFar;
         x = below ? lo_plane : (above ? hi_plane : x);
         v = (below || above) ? Real(0) : v;
     }

@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "algorithms/wall_contact.hpp"
 #include "backend/backend_registry.hpp"
 #include "sampling/box_particles.hpp"
+#include "sampling/fluid_clearance.hpp"
 #include "sampling/wall_gap.hpp"
 #include "test_setups.hpp"
 
@@ -57,6 +60,15 @@ TEST_CASE("wall contact: a particle moving outward inside the band is put back o
         const Vec3 x = walls.correct_predicted(Vec3{0.5f, -0.01f, 0.5f}, Vec3{0, -1, 0});
         CHECK(x.y == doctest::Approx(0.4 * r0));
     }
+    SUBCASE("non-finite positions and velocities are left for the guard") {
+        const Real inf = std::numeric_limits<Real>::infinity();
+        Vec3 x{0.5f, -inf, 0.5f}, v{0, -1, 0};
+        walls.correct(x, v);
+        CHECK(std::isinf(x.y));
+        Vec3 y{0.5f, 0, 0.5f}, w{0, -inf, 0};
+        walls.correct(y, w);
+        CHECK(std::isinf(w.y));
+    }
     SUBCASE("inactive (no walls): nothing moves") {
         const WallContact none;
         Vec3 x{0.5f, -1, 0.5f}, v{0, -1, 0};
@@ -78,20 +90,23 @@ TEST_CASE("wall contact: a fluid block touching a face starts on or beyond the p
                 const WallContact walls = WallContact::for_domain({0, 0, 0}, {1, 1, 1}, gap, r0);
                 CAPTURE(layers);
                 CAPTURE(gap / r0);
-                CHECK(walls.lo.y <= r0 / 2 + 1e-7f);
-                CHECK(walls.hi.y >= 1 - r0 / 2 - 1e-7f);
+                // At least 0.1 r0 of slack below where that fluid rests (r0/2 inside the face).
+                CHECK(walls.lo.y <= Real(0.4) * r0 + 1e-7f);
+                CHECK(walls.hi.y >= 1 - Real(0.4) * r0 - 1e-7f);
                 // Never farther than r0 from the layer (the paper's distance), never outside the layer.
                 CHECK(walls.lo.y + gap <= r0 * (1 + 1e-5f));
                 CHECK(walls.lo.y + gap > 0);
+                // One layer at h >= 2 r0 has that slack already: the band is the paper's r0.
+                if (layers == 1 && kernel == KernelKind::kCubicSpline)
+                    CHECK(walls.lo.y + gap == doctest::Approx(r0));
             }
 }
 
 TEST_CASE("wall contact: static boxes, with a band rounded at their edges") {
     const Real r0 = 0.02f;
-    const ContactBox box{{0.4f, 0, 0.4f}, {0.6f, 0.2f, 0.6f}};
+    const ContactBox box{{0.4f, 0, 0.4f}, {0.6f, 0.2f, 0.6f}, r0};
     WallContact contact;  // no domain walls: the box alone
     contact.boxes = View<const ContactBox>{&box, 1};
-    contact.box_contact = r0;
 
     SUBCASE("above the top face, falling: back to r0 above it, the normal speed gone") {
         Vec3 x{0.5f, Real(0.2) + Real(0.3) * r0, 0.5f}, v{1, -4, 0};
@@ -108,8 +123,9 @@ TEST_CASE("wall contact: static boxes, with a band rounded at their edges") {
         const Real off = r0 / std::sqrt(Real(2));
         CHECK(x.x == doctest::Approx(0.6 + off));
         CHECK(x.y == doctest::Approx(0.2 + off));
-        CHECK(v.x == doctest::Approx(0).epsilon(1e-6));
-        CHECK(v.y == doctest::Approx(0).epsilon(1e-6));
+        // Only about 0: in a double build the float literals put the point a hair off the diagonal.
+        CHECK(std::fabs(v.x) < 1e-5);
+        CHECK(std::fabs(v.y) < 1e-5);
         CHECK(v.z == doctest::Approx(0.5));
     }
     SUBCASE("off the edge by more than r0, though within r0 of both faces' planes: untouched") {
@@ -125,12 +141,43 @@ TEST_CASE("wall contact: static boxes, with a band rounded at their edges") {
         CHECK(x.y == doctest::Approx(0.2 + r0));
         CHECK(v.y == doctest::Approx(0).epsilon(1e-6));
     }
+    SUBCASE("inside the box, moving along its nearest face: still out through that face") {
+        // Near the side face x = 0.6, falling: no velocity into that face, but inside is never right.
+        Vec3 x{Real(0.6) - Real(0.1) * r0, 0.1f, 0.5f}, v{0, -3, 0};
+        contact.correct(x, v);
+        CHECK(x.x == doctest::Approx(0.6 + r0));
+        CHECK(v.y == doctest::Approx(-3));  // tangential to that face: kept
+    }
+    SUBCASE("inside the box, already moving out: out through the nearest face, its speed kept") {
+        Vec3 x{0.5f, Real(0.2) - Real(0.2) * r0, 0.45f}, v{0, 2, 0};
+        contact.correct(x, v);
+        CHECK(x.y == doctest::Approx(0.2 + r0));
+        CHECK(v.y == doctest::Approx(2));
+    }
     SUBCASE("near the box but leaving it: untouched") {
         Vec3 x{0.5f, Real(0.2) + Real(0.3) * r0, 0.5f}, v{0, 2, 0};
         contact.correct(x, v);
         CHECK(x.y == doctest::Approx(0.2 + 0.3 * r0));
         CHECK(v.y == doctest::Approx(2));
     }
+}
+
+TEST_CASE("wall contact: a static box's band stays inside the closest the carve lets fluid start") {
+    // The scene builder keeps fluid kFluidClearance r0 from a box's particles, which sit on a
+    // square grid of r0/2 on its faces: above the middle of a grid square that is 0.935 r0 from
+    // the face. A band wider than that would hold fluid that starts at rest.
+    const Real r0 = 0.02f;
+    const Real carved = carved_face_distance(Real(kFluidClearance) * r0, r0 / 2);
+    CHECK(carved / r0 == doctest::Approx(std::sqrt(0.875)).epsilon(1e-5));
+    const Real rest = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1, KernelKind::kCubicSpline) + r0 / 2;
+    CHECK(contact_distance(rest, r0) == doctest::Approx(r0));  // 1.1 r0 rest: the paper's r0
+    CHECK(std::min(contact_distance(rest, r0), carved) / r0 == doctest::Approx(0.935).epsilon(1e-3));
+    // The particles sample_solid_box places: none closer to the face grid than the grid spacing.
+    const std::vector<Vec3> face = sample_solid_box({0, 0, 0}, {0.2f, 0.2f, 0.2f}, r0 / 2, 1);
+    const Vec3 middle{Real(0.1) + r0 / 4, Real(0.2) + carved, Real(0.1) + r0 / 4};  // over a square's middle
+    Real nearest = 1e9f;
+    for (const Vec3& p : face) nearest = std::min(nearest, norm(p - middle));
+    CHECK(nearest >= r0 * (1 - 1e-4f));  // the carve keeps it
 }
 
 namespace {
@@ -152,7 +199,7 @@ Impact drive_into_wall(bool correction, bool static_box = false) {
     setup.params.gravity = {0, 0, 0};
     setup.params.wall_correction = correction;
     if (static_box) {
-        const ContactBox box{{0.1f, 0.02f, 0.1f}, {0.2f, 0.3f, 0.5f}};
+        const ContactBox box{{0.1f, 0.02f, 0.1f}, {0.2f, 0.3f, 0.5f}, r0};
         for (const Vec3& p : sample_solid_box(box.lo, box.hi, r0 / 2, 1)) {
             setup.position.push_back(p);
             setup.velocity.push_back(Vec3{0, 0, 0});
@@ -215,12 +262,13 @@ TEST_CASE("wall contact: a block driven into a static box at 20 m/s stays out of
     CHECK(without.lowest == 0);  // a particle got inside the box, past its layer
     const Impact with = drive_into_wall(true, true);
     CHECK(with.lost == 0);
-    // Never inside, nor near the layer: the rule acts on where a step ends, and a particle that
-    // passes an edge in a straight step can end within r0 of it already moving away, which the
-    // rule leaves alone (measured: 0.89 r0 at the closest).
-    CHECK(with.lowest > Real(0.5) * r0);
+    // Never inside, and well off the layer. The rule acts on where a step ends, so a particle
+    // that passes an edge in a straight step can end within the band already moving away, which
+    // the rule leaves alone: the closest is not r0 (measured: 1.00 r0 in float, 0.60 r0 in a
+    // double build, where the chaotic splash goes otherwise).
+    CHECK(with.lowest > Real(0.25) * r0);
     CHECK(with.lowest < Real(1.01) * r0);
-    // Not asserted: the kinetic energy. The fluid squirts round the box's edges at this step
-    // (two spacings a step), and PCISPH then gains energy with the correction or without it
-    // (measured: 5% and 45% over the first step's).
+    // Not asserted: the kinetic energy. The fluid squirts round the box's edges at this step (two
+    // spacings a step) and PCISPH can gain energy there with the correction as without it
+    // (measured over the first step's: 1.00 and 1.45 in float, 1.32 and 1.45 in double).
 }
