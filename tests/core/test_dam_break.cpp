@@ -141,7 +141,7 @@ TEST_CASE("dam break against Martin & Moyce: the column's height follows their t
 }
 
 // The same bounds with the other kernel: the front's lead does not come from the kernel.
-// Measured: heights within 2.6%, the front 18.1% ahead at T = 1.19 (cubic spline: 1.8%, 16.3%).
+// Measured: heights within 1.4%, the front 18.4% ahead at T = 1.19 (cubic spline: 1.8%, 16.3%).
 // Before the walls' correction, at h = 2.5 r0 (not asserted), the heights fell up to 3.1% low and
 // the front led by 18.7%.
 TEST_CASE("dam break against Martin & Moyce with the Wendland C2 kernel: the same height, the same lead") {
