@@ -59,9 +59,11 @@ struct SimulationParams {
     // negative: not given. Needed with domain_walls when wall_correction is on.
     Real wall_gap = -1;
     // The velocity–position correction against the domain walls and the static boxes
-    // (algorithms/wall_contact.hpp): fluid moving into them never comes closer than r0 to their
-    // first layer.
-    bool wall_correction = true;
+    // (algorithms/wall_contact.hpp): fluid moving into them stops about r0 from their first
+    // layer. Off unless asked for, like every physics switch added after the first release; the
+    // shipped scenes with walls ask for it (boundary.correction), and so do the tests' and the
+    // benchmarks' dam breaks built in code, which check what those scenes run.
+    bool wall_correction = false;
     // The static boxes' faces, for that correction (their particles are in the setup's lists).
     std::vector<ContactBox> static_boxes;
     Vec3 gravity{0, -9.81f, 0};

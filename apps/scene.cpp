@@ -396,7 +396,7 @@ void read_boundary(Section s, Scene& scene) {
     scene.walls = s.boolean("walls", true);
     scene.boundary_spacing_factor = Real(s.number("spacing_factor", 0.5, Range{0, 1, true, false}));
     scene.boundary_layers = s.integer("layers", 1, 1, 8);
-    scene.params.wall_correction = s.boolean("correction", true);
+    scene.params.wall_correction = s.boolean("correction", false);  // off unless the scene asks (the shipped scenes do)
     scene.max_lost_fraction = s.number("max_lost_fraction", scene.walls ? 0.01 : 1.0, Range{0, 1});
     s.finish();
 }

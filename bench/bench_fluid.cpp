@@ -130,6 +130,7 @@ SimulationSetup dam_break(long target, CellOrdering ordering, KernelKind kernel 
     s.params.domain_walls = true;
     const Real gap = rest_density_wall_gap(r0, s.params.fluid.support_radius, r0 / 2, 1, kernel);
     s.params.wall_gap = gap;
+    s.params.wall_correction = true;  // as scenes/dam_break.json runs
     for (const Vec3& p : sample_container_walls(s.params.domain_min, s.params.domain_max, r0 / 2, 1, gap)) {
         s.position.push_back(p);
         s.type.push_back(kStaticBoundary);

@@ -42,6 +42,7 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
     if (walls) {
         const Real gap = rest_density_wall_gap(r0, setup.params.fluid.support_radius, r0 / 2, 1, kernel);
         setup.params.wall_gap = gap;
+        setup.params.wall_correction = true;  // as the shipped scenes run (boundary.correction)
         for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, gap)) {
             setup.position.push_back(p);
             setup.type.push_back(kStaticBoundary);
