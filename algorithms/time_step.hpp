@@ -143,8 +143,8 @@ class BackendSimulation final : public Simulation {
     // sort's buffers, sized by the largest sort of the process so far).
     std::size_t device_bytes() const override {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
-               pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() + contact_boxes_.bytes() +
-               backend_scratch_bytes();
+               pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
+               contact_boxes_.bytes() + backend_scratch_bytes();
     }
     double time() const override { return time_; }
     std::string backend_name() const override { return kBackendName; }

@@ -24,7 +24,8 @@
 // start r0/2 inside the faces), so the band is r0 for one layer and 0.875 r0 for two. Static
 // boxes: their first layer lies on their faces, so the rest distance is the same for the same
 // layers, and the band is also kept inside the distance at which the scene builder's carve can
-// leave fluid (contact_distances()). Near a box's edges and corners the band is rounded (the
+// leave fluid (carved_face_distance(), sampling/fluid_clearance.hpp; apps/scene_builder.cpp
+// sets each box's band). Near a box's edges and corners the band is rounded (the
 // distance to the box, not to its faces' planes), so fluid flowing round an edge is not pushed
 // off it.
 #pragma once
@@ -106,7 +107,8 @@ struct WallContact {
                 if (depth[f] < depth[face]) face = f;
             const Real sign = (face & 1) ? Real(1) : Real(-1);
             const int axis_index = face >> 1;
-            n = Vec3{axis_index == 0 ? sign : Real(0), axis_index == 1 ? sign : Real(0), axis_index == 2 ? sign : Real(0)};
+            n = Vec3{axis_index == 0 ? sign : Real(0), axis_index == 1 ? sign : Real(0),
+                     axis_index == 2 ? sign : Real(0)};
             if (axis_index == 0) surface.x = (face & 1) ? b.hi.x : b.lo.x;
             if (axis_index == 1) surface.y = (face & 1) ? b.hi.y : b.lo.y;
             if (axis_index == 2) surface.z = (face & 1) ? b.hi.z : b.lo.z;

@@ -63,8 +63,9 @@ std::string lost_fluid_message(const StepReport& r, long fluid_count, long diver
 
 std::string density_blowup_message(const StepReport& r, long diverged_steps, const Scene& scene) {
     char head[200];
-    std::snprintf(head, sizeof head, "step %ld (t = %.6g s): the fluid is packed %.3g%% above its rest density, more than ",
-                  r.step, r.time, 100.0 * r.density_error_max);
+    std::snprintf(head, sizeof head,
+                  "step %ld (t = %.6g s): the fluid is packed %.3g%% above its rest density, more than ", r.step,
+                  r.time, 100.0 * r.density_error_max);
     return head + ("solver.max_density_error " + format_number(scene.max_density_error)) +
            (diverged_steps > 0 ? "; PCISPH diverged in " + count_of(diverged_steps, "step") +
                                      " so far (column diverged of stats.csv): use a smaller dt, or dt_mode \"cfl\""
