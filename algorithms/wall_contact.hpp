@@ -43,10 +43,11 @@ struct ContactBox {
     Real contact = 0;
 };
 
-// The band's width for a boundary whose fluid rests `rest` from its first layer: r0, at most
-// rest - 0.1 r0.
-inline Real contact_distance(Real rest, Real r0) {
-    const Real short_of_rest = rest - Real(0.1) * r0;
+// The band's width for a boundary whose first layer lies `gap` (sampling/wall_gap.hpp) from
+// where fluid blocks start, r0/2 outside the fluid: that fluid rests gap + r0/2 from the layer,
+// and the band is r0, at most that less 0.1 r0.
+inline Real contact_distance(Real gap, Real r0) {
+    const Real short_of_rest = gap + r0 / 2 - Real(0.1) * r0;
     return r0 < short_of_rest ? r0 : short_of_rest;
 }
 
@@ -61,7 +62,7 @@ struct WallContact {
 
     // For a domain [domain_lo, domain_hi] whose walls' first layer lies `gap` outside the faces.
     static WallContact for_domain(Vec3 domain_lo, Vec3 domain_hi, Real gap, Real r0) {
-        const Real contact = contact_distance(gap + r0 / 2, r0);
+        const Real contact = contact_distance(gap, r0);
         const Real inward = contact - gap;  // from the face into the domain (negative: outside it)
         WallContact c;
         c.lo = Vec3{domain_lo.x + inward, domain_lo.y + inward, domain_lo.z + inward};

@@ -112,13 +112,12 @@ int command_info(int argc, char** argv) {
                     double(f.support_radius / f.spacing), scene.static_boxes.size());
     else
         std::printf("boundary    no domain walls; %zu static box(es)\n", scene.static_boxes.size());
-    if (scene.params.wall_correction && (scene.walls || !scene.static_boxes.empty()))
+    const bool boxes = !scene.static_boxes.empty();
+    if ((scene.walls || boxes) && scene.params.wall_correction)
         std::printf("            velocity-position correction on (boundary.correction): fluid moving into the %s "
                     "stops about r0 from the boundary layer\n",
-                    scene.walls && !scene.static_boxes.empty() ? "walls or a static box"
-                    : scene.walls                               ? "walls"
-                                                                : "static boxes");
-    else if (scene.walls || !scene.static_boxes.empty())
+                    scene.walls && boxes ? "walls or a static box" : scene.walls ? "walls" : "static boxes");
+    else if (scene.walls || boxes)
         std::printf("            velocity-position correction off (boundary.correction false): only the Akinci "
                     "layers hold the fluid in\n");
     if (const std::string warning = scene.kernel_warning(); !warning.empty())

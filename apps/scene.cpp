@@ -384,11 +384,11 @@ void read_solver(Section s, Scene& scene) {
     p.eta = Real(eta);
     p.eta_max = Real(s.number("eta_max", default_eta_max(eta), Range{0, 1, false, true}));
     p.min_iterations = s.integer("min_iterations", 3, 1, 1000);
-    scene.max_density_error = s.number("max_density_error", 1.0, Range::positive());
     p.max_iterations = s.integer("max_iterations", 100, 1, 10000);
     if (p.max_iterations < p.min_iterations)
         s.fail(s.key_path("max_iterations"), "must be >= min_iterations (" + std::to_string(p.min_iterations) +
                                                  "), got " + std::to_string(p.max_iterations));
+    scene.max_density_error = s.number("max_density_error", 1.0, Range::positive());
     s.finish();
 }
 

@@ -182,10 +182,10 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         // The band the walls' correction keeps moving fluid out of (algorithms/wall_contact.hpp):
         // 0.1 r0 short of where fluid rests against this box's layers, and no wider than the
         // carve below lets fluid start.
-        const Real rest = rest_density_wall_gap(r0, scene.params.fluid.support_radius, rb, b.layers,
-                                                scene.params.fluid.kernel) + r0 / 2;
+        const Real gap =
+            rest_density_wall_gap(r0, scene.params.fluid.support_radius, rb, b.layers, scene.params.fluid.kernel);
         const Real carved = carved_face_distance(Real(kFluidClearance) * r0, rb);
-        setup.params.static_boxes.push_back(ContactBox{b.min, b.max, std::min(contact_distance(rest, r0), carved)});
+        setup.params.static_boxes.push_back(ContactBox{b.min, b.max, std::min(contact_distance(gap, r0), carved)});
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
                static_cast<std::int32_t>(i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));

@@ -1,6 +1,7 @@
-// The velocity–position correction against the domain walls (algorithms/wall_contact.hpp): the
-// rule on single particles, where its planes lie, and a block driven into a wall far faster than
-// one Akinci layer can stop, with the correction and without.
+// The velocity–position correction against the domain walls and static boxes
+// (algorithms/wall_contact.hpp): the rule on single particles, where its bands lie, and a block
+// driven into a wall or a box far faster than one Akinci layer can stop, with the correction and
+// without.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -169,9 +170,9 @@ TEST_CASE("wall contact: a static box's band stays inside the closest the carve 
     const Real r0 = 0.02f;
     const Real carved = carved_face_distance(Real(kFluidClearance) * r0, r0 / 2);
     CHECK(carved / r0 == doctest::Approx(std::sqrt(0.875)).epsilon(1e-5));
-    const Real rest = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1, KernelKind::kCubicSpline) + r0 / 2;
-    CHECK(contact_distance(rest, r0) == doctest::Approx(r0));  // 1.1 r0 rest: the paper's r0
-    CHECK(std::min(contact_distance(rest, r0), carved) / r0 == doctest::Approx(0.935).epsilon(1e-3));
+    const Real gap = rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1, KernelKind::kCubicSpline);
+    CHECK(contact_distance(gap, r0) == doctest::Approx(r0));  // rests at 1.1 r0: the paper's r0
+    CHECK(std::min(contact_distance(gap, r0), carved) / r0 == doctest::Approx(0.935).epsilon(1e-3));
     // The particles sample_solid_box places: none closer to the face grid than the grid spacing.
     const std::vector<Vec3> face = sample_solid_box({0, 0, 0}, {0.2f, 0.2f, 0.2f}, r0 / 2, 1);
     const Vec3 middle{Real(0.1) + r0 / 4, Real(0.2) + carved, Real(0.1) + r0 / 4};  // over a square's middle
