@@ -143,8 +143,9 @@ struct StepReport {
     long lost_particles = 0;   // fluid particles that have left the domain so far
     double solid_kinetic_energy = 0;  // J over the IBPs of moving solids
     double solid_max_speed = 0;       // m/s over the same
-    int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged
+    int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged or ran out of iterations
     bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
+    bool unconverged = false;  // the last try ran out of iterations above η (or eta_max), without diverging
     std::vector<double> stage_ms;  // per stage, same order as stage_names(); 0 for a stage not run
     double total_ms = 0;
 };

@@ -75,8 +75,11 @@ class BackendSimulation final : public Simulation {
         //    In CFL mode a step whose iteration diverges is tried again from the same state at half
         //    the step (nothing before the integration has moved a particle): the CFL bound does
         //    not see a flat impact, where a whole column must stop at once (docs/solver.md).
+        //    So is a step that ran out of iterations above the tolerance: at CFL numbers near 1
+        //    such steps (4-5 ms in the dam break) ended at max_iterations with the peak error
+        //    above 100% while the average never doubled (docs/solver.md, "Large CFL numbers").
         int iterations = 0, retries = 0;  // iterations: of every try of the step
-        bool diverged = false;
+        PcisphOutcome outcome = PcisphOutcome::kConverged;
         DensityError error;
         if (has_fluid_) {
             timers_.start(kPcisph);
@@ -84,10 +87,11 @@ class BackendSimulation final : public Simulation {
                 const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
                 int tried = 0;
                 error = use_lists_
-                            ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, tried, diverged)
-                            : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, tried, diverged);
+                            ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, tried, outcome)
+                            : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, tried, outcome);
                 iterations += tried;
-                if (!diverged || !StepSizeControl::may_retry(params_.solver, retries, dt)) break;
+                if (outcome == PcisphOutcome::kConverged || !StepSizeControl::may_retry(params_.solver, retries, dt))
+                    break;
                 dt *= Real(0.5);
                 ++retries;
             }
@@ -122,7 +126,8 @@ class BackendSimulation final : public Simulation {
             report_non_finite(solids_.store_index_of_slot(solid_motion.first_bad), "solid inner particle (IBP)");
         fill_report(dt, iterations, error, fluid_count, motion);
         report_.retries = retries;
-        report_.diverged = diverged;
+        report_.diverged = outcome == PcisphOutcome::kDiverged;
+        report_.unconverged = outcome == PcisphOutcome::kOutOfIterations;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
         report_.solid_max_speed = std::sqrt(double(solid_motion.max_speed2));
         // The next CFL step bounds every moving particle's travel, a solid's as well as the
@@ -154,17 +159,19 @@ class BackendSimulation final : public Simulation {
     // The PCISPH loop over a neighbourhood (the grid, or this step's lists): predict, density and
     // pressure, error, pressure force; until the average error is below η, and the largest below
     // eta_max when that is set (min/max iterations).
-    // `diverged`: the average error rose to more than twice the lowest it reached in this step
+    // `outcome`: converged (below the tolerance), diverged, or out of iterations above it.
+    // Diverged: the average error rose to more than twice the lowest it reached in this step
     // while above η (or, with eta_max, the largest error did, above eta_max). PCISPH's pressure
     // then overshoots and feeds on itself; iterating on only throws the fluid apart, so the loop
     // stops there.
+    enum class PcisphOutcome { kConverged, kDiverged, kOutOfIterations };
     template <class Neighbors>
     DensityError pcisph_iterations(const Neighbors& neighbors, std::size_t fluid_count, const Vec3* nonpressure,
-                                   Real delta, Real dt, int& iterations, bool& diverged) {
+                                   Real delta, Real dt, int& iterations, PcisphOutcome& outcome) {
         const SolverParams& solver = params_.solver;
         DensityError error;
         iterations = 0;
-        diverged = false;
+        outcome = PcisphOutcome::kOutOfIterations;
         double lowest_average = 1e300, lowest_peak = 1e300;
         while (iterations < solver.max_iterations) {
             // The first prediction has no pressure acceleration yet (nothing to clear beforehand).
@@ -186,12 +193,15 @@ class BackendSimulation final : public Simulation {
             error = density_error(fluid_count, store_.density.cview(), fluid_.rest_density);
             const double average = fluid_count ? error.sum / double(fluid_count) : 0.0;
             const bool peak_ok = solver.eta_max <= 0 || error.max <= solver.eta_max;
-            if (average <= solver.eta && peak_ok) break;
+            if (average <= solver.eta && peak_ok) {
+                outcome = PcisphOutcome::kConverged;
+                break;
+            }
             lowest_average = std::min(lowest_average, average);
             lowest_peak = std::min(lowest_peak, double(error.max));
             if ((average > 2 * lowest_average && lowest_average > solver.eta) ||
                 (solver.eta_max > 0 && error.max > 2 * lowest_peak && lowest_peak > solver.eta_max)) {
-                diverged = true;
+                outcome = PcisphOutcome::kDiverged;
                 break;
             }
         }

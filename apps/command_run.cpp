@@ -286,14 +286,22 @@ int command_run(int argc, char** argv) {
 
     if (stats.retried_steps() > 0 && !quiet)
         std::fprintf(stderr,
-                     "meltwater: note: %s taken again at a smaller dt because PCISPH diverged (column "
-                     "dt_retries of stats.csv; docs/solver.md, \"Flat impacts\")\n",
+                     "meltwater: note: %s taken again at a smaller dt because PCISPH diverged or ran out of "
+                     "iterations (column dt_retries of stats.csv; docs/solver.md, \"Flat impacts\")\n",
                      (count_of(stats.retried_steps(), "step") + (stats.retried_steps() == 1 ? " was" : " were")).c_str());
     if (stats.diverged_steps() > 0)
         std::fprintf(stderr,
                      "meltwater: warning: in %s PCISPH diverged and the step was integrated anyway (column "
                      "diverged of stats.csv); use a smaller dt, or dt_mode \"cfl\" with solver.eta_max\n",
                      count_of(stats.diverged_steps(), "step").c_str());
+    if (stats.unconverged_steps() > 0)
+        std::fprintf(stderr,
+                     "meltwater: warning: in %s PCISPH ran out of iterations (solver.max_iterations %d) above its "
+                     "tolerance and the step was integrated anyway (column unconverged of stats.csv)%s\n",
+                     count_of(stats.unconverged_steps(), "step").c_str(), scene.params.solver.max_iterations,
+                     scene.params.solver.dt_mode == TimeStepMode::kCfl
+                         ? ""
+                         : "; use a smaller dt, more iterations, or dt_mode \"cfl\"");
     if (summary.lost_particles > 0)
         std::fprintf(stderr, "meltwater: warning: %s left the domain (column lost_particles of stats.csv)\n",
                      count_of(summary.lost_particles, "fluid particle").c_str());

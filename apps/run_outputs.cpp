@@ -106,10 +106,10 @@ StatsTable::StatsTable(std::vector<std::string> stage_names)
     : stages_(std::move(stage_names)), stage_ms_(stages_.size()) {}
 
 void StatsTable::add(const StepReport& r) {
-    char buffer[160];
-    std::snprintf(buffer, sizeof buffer, "%ld,%.9g,%.9g,%d,%.6g,%.6g,%.6g,%.6g,%ld,%d,%d", r.step, r.time, r.dt,
+    char buffer[256];
+    std::snprintf(buffer, sizeof buffer, "%ld,%.9g,%.9g,%d,%.6g,%.6g,%.6g,%.6g,%ld,%d,%d,%d", r.step, r.time, r.dt,
                   r.iterations, r.density_error_avg, r.density_error_max, r.max_speed, r.kinetic_energy,
-                  r.lost_particles, r.retries, r.diverged ? 1 : 0);
+                  r.lost_particles, r.retries, r.diverged ? 1 : 0, r.unconverged ? 1 : 0);
     csv_rows_ += buffer;
     for (std::size_t s = 0; s < stages_.size(); ++s) {
         const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
@@ -125,12 +125,13 @@ void StatsTable::add(const StepReport& r) {
     iterations_.push_back(r.iterations);
     retried_steps_ += r.retries > 0;
     diverged_steps_ += r.diverged;
+    unconverged_steps_ += r.unconverged;
 }
 
 std::string StatsTable::header() const {
     std::string h =
         "step,time,dt,iterations,density_error_avg,density_error_max,max_speed,kinetic_energy,lost_particles,"
-        "dt_retries,diverged";
+        "dt_retries,diverged,unconverged";
     for (const auto& s : stages_) h += ",ms_" + s;
     return h + ",ms_total";
 }
@@ -211,6 +212,7 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     j["iterations"] = {{"avg", stats.iterations_avg()}, {"max", stats.iterations_max()}};
     j["retried_steps"] = stats.retried_steps();
     j["diverged_steps"] = stats.diverged_steps();
+    j["unconverged_steps"] = stats.unconverged_steps();
     j["device_bytes"] = run.device_bytes;
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;

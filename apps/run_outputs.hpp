@@ -59,6 +59,8 @@ class StatsTable {
     int iterations_max() const;
     long retried_steps() const { return retried_steps_; }  // steps retried at a smaller dt (CFL mode)
     long diverged_steps() const { return diverged_steps_; }  // steps whose last PCISPH try diverged
+    // steps whose last PCISPH try ran out of iterations above the tolerance
+    long unconverged_steps() const { return unconverged_steps_; }
     double sum_total_ms() const;
 
    private:
@@ -67,7 +69,7 @@ class StatsTable {
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]
     std::vector<double> total_ms_, error_avg_, error_max_;
     std::vector<int> iterations_;
-    long retried_steps_ = 0, diverged_steps_ = 0;
+    long retried_steps_ = 0, diverged_steps_ = 0, unconverged_steps_ = 0;
 };
 
 struct RunSummary {

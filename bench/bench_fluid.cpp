@@ -7,6 +7,9 @@
 //   3. The same dam break with linear and Z-order cell orderings, with grid gathers, and with
 //      viscosity (Eq. 4 with the fluid's mirror images across the walls; the backend's gathers).
 //   4. The Wendland C2 kernel at h = 2 r0 and 2.5 r0 (fluid.kernel).
+//   5. The time step's trade: the default scene (scenes/dam_break.json) run whole at its CFL
+//      number 0.4 under 1.5 ms and at CFL 0.8 and 1 under the paper's 30 ms: steps, iterations,
+//      time to the end, and how far its kinetic energy strays from the CFL 0.4 run's.
 // Prints a Markdown report and, with --out FILE, appends it there, each section as soon as it is
 // measured.
 #include <algorithm>
@@ -36,7 +39,7 @@ struct Options {
     bool quick = false;
     std::string out;
     // The report's sections to run (--sections, comma-separated): all by default.
-    std::vector<std::string> sections{"dams", "splish", "variants", "kernels"};
+    std::vector<std::string> sections{"dams", "splish", "variants", "kernels", "steps"};
     bool wants(const std::string& section) const {
         return std::find(sections.begin(), sections.end(), section) != sections.end();
     }
@@ -145,6 +148,71 @@ SimulationSetup with_lists(SimulationSetup s, bool lists) {
     return s;
 }
 
+// A whole run to `end_time`: what the time step's choice costs and what it changes.
+struct WholeRun {
+    std::string name;
+    long fluid = 0;
+    long steps = 0, iterations = 0, halvings = 0, unconverged = 0, diverged = 0;
+    double ms_total = 0;  // the stages' time summed over every step
+    double error_max = 0, top_speed = 0;
+    std::vector<double> time, kinetic_energy;  // after each step
+    double energy_at(double t) const {  // linear between the steps around t
+        std::size_t k = 1;
+        while (k + 1 < time.size() && time[k] < t) ++k;
+        const double w = (t - time[k - 1]) / (time[k] - time[k - 1]);
+        return kinetic_energy[k - 1] + w * (kinetic_energy[k] - kinetic_energy[k - 1]);
+    }
+};
+
+WholeRun run_whole(const Options& o, const std::string& name, const SimulationSetup& setup, double end_time) {
+    auto sim = make(o, setup);
+    WholeRun r;
+    r.name = name;
+    r.fluid = sim->counts().by_type[kFluid];
+    r.time.push_back(0);
+    r.kinetic_energy.push_back(0);  // the column starts at rest
+    while (sim->time() < end_time) {
+        sim->step();
+        const StepReport& rep = sim->last_report();
+        ++r.steps;
+        r.iterations += rep.iterations;
+        r.halvings += rep.retries;
+        r.unconverged += rep.unconverged;
+        r.diverged += rep.diverged;
+        r.ms_total += rep.total_ms;
+        r.error_max = std::max(r.error_max, rep.density_error_max);
+        r.top_speed = std::max(r.top_speed, rep.max_speed);
+        r.time.push_back(sim->time());
+        r.kinetic_energy.push_back(rep.kinetic_energy);
+    }
+    std::fprintf(stderr, "  %-44s %6ld steps %7ld iterations %8.2f s\n", name.c_str(), r.steps, r.iterations,
+                 r.ms_total / 1000);
+    return r;
+}
+
+// The first run is the reference: the others' kinetic energy is compared with its at every
+// tenth of a second.
+std::string format_whole_runs(const std::vector<WholeRun>& runs, double end_time) {
+    std::ostringstream t;
+    t << "| case | steps | halvings of a step | unconverged | diverged | iterations | iterations/step | s to the end | "
+         "ms/step | peak density error | top speed m/s | kinetic energy, largest deviation from the first row |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    char cell[320];
+    for (const WholeRun& r : runs) {
+        double deviation = 0;
+        for (int k = 1; k <= int(std::floor(end_time * 10 + 1e-9)); ++k) {
+            const double reference = runs.front().energy_at(0.1 * k);
+            if (reference > 0) deviation = std::max(deviation, std::fabs(r.energy_at(0.1 * k) - reference) / reference);
+        }
+        std::snprintf(cell, sizeof cell, "| %s | %ld | %ld | %ld | %ld | %ld | %.2f | %.2f | %.2f | %.2f%% | %.2f | %.1f%% |\n",
+                      r.name.c_str(), r.steps, r.halvings, r.unconverged, r.diverged, r.iterations,
+                      double(r.iterations) / double(r.steps), r.ms_total / 1000, r.ms_total / double(r.steps),
+                      100 * r.error_max, r.top_speed, 100 * deviation);
+        t << cell;
+    }
+    return t.str();
+}
+
 std::string format_table(const std::vector<Result>& results) {
     std::ostringstream t;
     std::vector<std::string> stages;
@@ -193,21 +261,21 @@ int main(int argc, char** argv) {
             std::stringstream list(argv[++i]);
             for (std::string name; std::getline(list, name, ',');) {
                 if (!Options{}.wants(name)) {  // the default holds every section
-                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels)\n",
+                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels, steps)\n",
                                  name.c_str());
                     return 2;
                 }
                 chosen.push_back(name);
             }
             if (chosen.empty()) {
-                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels\n");
+                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels, steps\n");
                 return 2;
             }
             o.sections = chosen;
         } else {
             std::fprintf(stderr,
                          "usage: bench_fluid [--backend openmp|cuda] [--threads N] [--large] [--quick] "
-                         "[--sections dams,splish,variants,kernels] [--out FILE]\n");
+                         "[--sections dams,splish,variants,kernels,steps] [--out FILE]\n");
             return 2;
         }
     }
@@ -335,6 +403,30 @@ int main(int argc, char** argv) {
                                                      true),
                                           measured_steps(100000), 2, warmup_time(100000)));
             emit("### Kernels (fluid.kernel), Z-order cells, neighbour lists\n\n" + format_table(kernels) + "\n");
+        }
+        // The time step's trade, whole runs of the default scene (the CLI's setup, bitwise): its
+        // own CFL 0.4 under 1.5 ms first, the reference; then larger CFL numbers under the paper's
+        // 30 ms, which need the retries of steps that diverge or run out of iterations.
+        if (o.wants("steps")) {
+            const double end_time = o.quick ? 0.5 : 1.5;
+            struct StepCase {
+                const char* cfl_number;
+                const char* largest;
+            };
+            std::vector<WholeRun> runs;
+            for (const StepCase c : {StepCase{"0.4", "0.0015"}, StepCase{"0.8", "0.03"}, StepCase{"1", "0.03"}}) {
+                const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/dam_break.json",
+                                               {std::string("solver.cfl_number=") + c.cfl_number,
+                                                std::string("solver.dt=") + c.largest});
+                runs.push_back(run_whole(o, std::string("CFL ") + c.cfl_number + ", largest step " + c.largest + " s",
+                                         build_setup(scene), end_time));
+            }
+            char title[200];
+            std::snprintf(title, sizeof title,
+                          "### Time step (scenes/dam_break.json, %ld fluid particles, to t = %.1f s; eta 1%%, eta_max 5%%)\n\n",
+                          runs.front().fluid, end_time);
+            emit(title + format_whole_runs(runs, end_time) +
+                 "\n's to the end' sums the stages' times over every step (no output written).\n\n");
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_fluid: %s\n", e.what());
