@@ -11,8 +11,9 @@ namespace mw {
 
 class StepSizeControl {
    public:
-    // Whether a step whose PCISPH iteration diverged at `dt` may be tried again at half of it
-    // (`retries` halvings so far): in CFL mode only, at most 6 times, never below min(dt_min, dt).
+    // Whether a step whose PCISPH iteration failed at `dt` (diverged, or ran out of iterations
+    // above the tolerance) may be tried again at half of it (`retries` halvings so far): in CFL
+    // mode only, at most 6 times, never below min(dt_min, dt).
     static bool may_retry(const SolverParams& solver, int retries, Real dt) {
         return solver.dt_mode == TimeStepMode::kCfl && retries < kMaxRetries &&
                Real(0.5) * dt >= std::min(solver.dt_min, solver.dt);
@@ -38,14 +39,18 @@ class StepSizeControl {
         return std::max(std::min(solver.dt_min, largest), std::min(largest, cfl_dt));
     }
 
-    // After each step's PCISPH: a step that needed retries sets the limit to the step that held;
-    // otherwise the limit grows by the current growth. The growth adapts to how often steps
-    // diverge: a retry within kWindow steps of the last halves its excess over 1 (down to
-    // kGrowthLeast), and every kWindow steps without one double it back (up to kGrowthMost). A
+    // After each step's PCISPH: a step that needed retries and then held sets the limit to the
+    // step that held; otherwise the limit grows by the current growth. The growth adapts to how
+    // often steps fail: a retry within kWindow steps of the last halves its excess over 1 (down
+    // to kGrowthLeast), and every kWindow steps without one double it back (up to kGrowthMost). A
     // resting column 20 layers deep at a largest step of 0.01 s had retried 109 of 478 steps with a
     // fixed growth of 1.25, the failed tries taking 48% of all iterations; with this, 30 retries
     // and 23% fewer iterations, while a dam break's isolated retries keep the quick growth.
-    void after_step(int retries, double dt_taken) {
+    // A step whose last try failed as well (`held` false) leaves limit and growth alone: halving
+    // did not rescue it, so its size was not the cause, and lowering the limit would only shrink
+    // every later step (a tolerance no step size reaches would drive the step to dt_min).
+    void after_step(int retries, bool held, double dt_taken) {
+        if (retries > 0 && !held) return;
         if (retries > 0) {
             if (steps_since_retry_ < kWindow) growth_ = std::max(kGrowthLeast, 1 + (growth_ - 1) / 2);
             steps_since_retry_ = 0;

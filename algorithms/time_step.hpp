@@ -97,7 +97,7 @@ class BackendSimulation final : public Simulation {
             }
             timers_.stop(kPcisph);
             // After a retry the next steps start from the step that held and grow back gradually.
-            step_size_.after_step(retries, dt);
+            step_size_.after_step(retries, outcome == PcisphOutcome::kConverged, dt);
         }
 
         // 5. Coupling forces on solids go here (they fill solids_.force()).

@@ -49,27 +49,39 @@ int report_interrupted_setup() {
 }
 
 // The lost-fluid guard's message: the step, how much fluid left, the limit, and the likely cause.
-std::string lost_fluid_message(const StepReport& r, long fluid_count, long diverged_steps, const Scene& scene) {
+// What PCISPH did before a run stopped: the steps integrated after the iteration diverged or ran
+// out of iterations (columns diverged and unconverged of stats.csv), or "" if none.
+std::string failed_iterations_hint(const StatsTable& stats) {
+    std::string hint;
+    if (stats.diverged_steps() > 0) hint += "diverged in " + count_of(stats.diverged_steps(), "step");
+    if (stats.unconverged_steps() > 0)
+        hint += (hint.empty() ? "" : " and ") + std::string("ran out of iterations above its tolerance in ") +
+                count_of(stats.unconverged_steps(), "step");
+    if (hint.empty()) return hint;
+    return "; PCISPH " + hint + " so far (columns diverged and unconverged of stats.csv): use a smaller dt, or "
+           "dt_mode \"cfl\"";
+}
+
+std::string lost_fluid_message(const StepReport& r, long fluid_count, const StatsTable& stats, const Scene& scene) {
     char head[200];
     std::snprintf(head, sizeof head, "step %ld (t = %.6g s): %s of %s (%.3g%%) have left the domain, more than ",
                   r.step, r.time, with_thousands(r.lost_particles).c_str(),
                   count_of(fluid_count, "fluid particle").c_str(), 100.0 * double(r.lost_particles) / double(fluid_count));
+    const std::string hint = failed_iterations_hint(stats);
     return head + ("boundary.max_lost_fraction " + format_number(scene.max_lost_fraction)) +
-           (diverged_steps > 0 ? "; PCISPH diverged in " + count_of(diverged_steps, "step") +
-                                     " so far (column diverged of stats.csv): use a smaller dt, or dt_mode \"cfl\""
-                               : std::string("; the fluid leaked through the walls or blew up (see the last frames "
-                                             "and stats.csv)"));
+           (!hint.empty() ? hint
+                          : std::string("; the fluid leaked through the walls or blew up (see the last frames "
+                                        "and stats.csv)"));
 }
 
-std::string density_blowup_message(const StepReport& r, long diverged_steps, const Scene& scene) {
+std::string density_blowup_message(const StepReport& r, const StatsTable& stats, const Scene& scene) {
     char head[200];
     std::snprintf(head, sizeof head,
                   "step %ld (t = %.6g s): the fluid is packed %.3g%% above its rest density, more than ", r.step,
                   r.time, 100.0 * r.density_error_max);
+    const std::string hint = failed_iterations_hint(stats);
     return head + ("solver.max_density_error " + format_number(scene.max_density_error)) +
-           (diverged_steps > 0 ? "; PCISPH diverged in " + count_of(diverged_steps, "step") +
-                                     " so far (column diverged of stats.csv): use a smaller dt, or dt_mode \"cfl\""
-                               : std::string("; the run blew up (see the last frames and stats.csv)"));
+           (!hint.empty() ? hint : std::string("; the run blew up (see the last frames and stats.csv)"));
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -230,11 +242,11 @@ int command_run(int argc, char** argv) {
             progress.update(r);
             if (r.lost_particles > scene.max_lost_fraction * double(summary.particles.by_type[kFluid])) {
                 progress.finish();
-                throw SimulationError(lost_fluid_message(r, summary.particles.by_type[kFluid], stats.diverged_steps(), scene));
+                throw SimulationError(lost_fluid_message(r, summary.particles.by_type[kFluid], stats, scene));
             }
             if (r.density_error_max > scene.max_density_error) {
                 progress.finish();
-                throw SimulationError(density_blowup_message(r, stats.diverged_steps(), scene));
+                throw SimulationError(density_blowup_message(r, stats, scene));
             }
             if (r.time >= next_frame_time * (1 - 1e-9)) {
                 write_frame();
@@ -287,7 +299,8 @@ int command_run(int argc, char** argv) {
     if (stats.retried_steps() > 0 && !quiet)
         std::fprintf(stderr,
                      "meltwater: note: %s taken again at a smaller dt because PCISPH diverged or ran out of "
-                     "iterations (column dt_retries of stats.csv; docs/solver.md, \"Flat impacts\")\n",
+                     "iterations (column dt_retries of stats.csv; docs/solver.md, \"Flat impacts\" and "
+                     "\"Sixteenth session\")\n",
                      (count_of(stats.retried_steps(), "step") + (stats.retried_steps() == 1 ? " was" : " were")).c_str());
     if (stats.diverged_steps() > 0)
         std::fprintf(stderr,
@@ -300,7 +313,8 @@ int command_run(int argc, char** argv) {
                      "tolerance and the step was integrated anyway (column unconverged of stats.csv)%s\n",
                      count_of(stats.unconverged_steps(), "step").c_str(), scene.params.solver.max_iterations,
                      scene.params.solver.dt_mode == TimeStepMode::kCfl
-                         ? ""
+                         ? "; halving the step (up to six times) did not rescue them: raise solver.max_iterations, or "
+                           "loosen solver.eta or solver.eta_max"
                          : "; use a smaller dt, more iterations, or dt_mode \"cfl\"");
     if (summary.lost_particles > 0)
         std::fprintf(stderr, "meltwater: warning: %s left the domain (column lost_particles of stats.csv)\n",

@@ -19,6 +19,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -73,10 +74,12 @@ long check_against_martin_moyce(KernelKind kernel, Real support_in_r0, StepChoic
         setup.params.solver.eta_max = Real(0.05);
     }
     const Real h = setup.params.fluid.support_radius;
-    const std::string steps_taken = step.cfl_number > 0 ? "CFL number " + std::to_string(step.cfl_number) +
-                                                              ", largest step " + std::to_string(step.largest) + " s"
-                                                        : std::string("fixed 1 ms steps");
-    MESSAGE(std::string(kernel_name(kernel)) << " kernel, h = " << support_in_r0 << " r0; " << steps_taken);
+    std::ostringstream steps_taken;
+    if (step.cfl_number > 0)
+        steps_taken << "CFL number " << step.cfl_number << ", largest step " << step.largest << " s";
+    else
+        steps_taken << "fixed 1 ms steps";
+    MESSAGE(std::string(kernel_name(kernel)) << " kernel, h = " << support_in_r0 << " r0; " << steps_taken.str());
     auto sim = create_openmp_simulation(setup, 0);
     long steps = 0, iterations = 0, halvings = 0;
     const double T[] = {0.41, 0.84, 1.19, 1.43, 1.63, 1.83, 1.98, 2.20, 2.32, 2.51};
@@ -178,8 +181,10 @@ TEST_CASE("dam break against Martin & Moyce with the Wendland C2 kernel: the sam
 // to τ = 1.84 (263 at the fixed 1 ms above, 178 at CFL 0.4 under 1.5 ms), 7 halvings of a step,
 // 817 PCISPH iterations (789 at 1 ms, 538 at CFL 0.4); heights within 2.0%, the front 15.4%
 // ahead at T = 1.19 (1 ms: 1.8% and 16.3%). Without the peak bound (eta_max 0) the front was at
-// the far wall by T = 0.41 (at CFL 0.4 under 30 ms, by T = 1.43).
+// the far wall by T = 0.41 (at CFL 0.4 under 30 ms, by T = 1.43). No step here runs out of
+// iterations: the 7 halvings are of diverging tries, and the run is the same without the retry
+// of unconverged steps (measured).
 TEST_CASE("dam break against Martin & Moyce at CFL number 1 and a 30 ms largest step: the same bounds, a third of the steps") {
     const long steps = check_against_martin_moyce(KernelKind::kCubicSpline, 2, {Real(1), Real(0.03)});
-    CHECK(steps < 263 / 2);
+    CHECK(steps < 263 / 2);  // 263: the fixed 1 ms run's steps to the same end (the first case)
 }
