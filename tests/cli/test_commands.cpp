@@ -634,6 +634,7 @@ TEST_CASE("guards: a blow-up inside the walls stops on solver.max_density_error"
     }
 }
 
+namespace {
 // stats.csv as rows of named numbers.
 std::vector<std::map<std::string, double>> read_stats(const std::string& path) {
     std::istringstream text(slurp(path));
@@ -651,6 +652,7 @@ std::vector<std::map<std::string, double>> read_stats(const std::string& path) {
     }
     return rows;
 }
+}  // namespace
 
 TEST_CASE("CFL mode: a step that runs out of iterations above the tolerance is taken again at half the step") {
     // The default dam break at r0 = 0.04 m (6,000 particles), CFL number 0.8 and a largest step
@@ -683,47 +685,60 @@ TEST_CASE("CFL mode: a step that runs out of iterations above the tolerance is t
     CHECK(read_json(dir + "/summary.json")["unconverged_steps"] == 0);
 }
 
+namespace {
+// Three steps of the tiny scene at a tolerance that no three iterations reach (min = max = 3,
+// so a try cannot diverge either: it always runs out of iterations), with `extra` settings.
+struct UnreachableRun {
+    Result result;
+    std::vector<std::map<std::string, double>> rows;  // stats.csv
+    nlohmann::json summary;
+};
+UnreachableRun run_at_unreachable_tolerance(const std::string& name, const std::string& extra) {
+    const std::string dir = out_dir(name);
+    UnreachableRun u;
+    u.result = run("run " + tiny() + " --steps 3 --out " + dir +
+                   " --set solver.eta=1e-6 --set solver.max_iterations=3 --set 'output.formats=[]'" + extra);
+    if (u.result.code != 0) return u;
+    u.rows = read_stats(dir + "/stats.csv");
+    u.summary = read_json(dir + "/summary.json");
+    return u;
+}
+}  // namespace
+
 TEST_CASE("CFL mode: a tolerance no step size reaches does not shrink the step to nothing") {
-    // Every try runs out of its 3 iterations, at every halving: each step is tried 7 times and
-    // integrated unconverged, and since halving did not rescue it, the next step starts again
-    // from the CFL bound, not from the last halving (which would divide it by 64 each step).
-    const std::string dir = out_dir("cfl_unreachable");
-    const Result r = run("run " + tiny() + " --steps 3 --out " + dir +
-                         " --set solver.dt_mode=cfl --set solver.eta=1e-6 --set solver.eta_max=0"
-                         " --set solver.max_iterations=3 --set 'output.formats=[]'");
-    CAPTURE(r.err);
-    REQUIRE(r.code == 0);
-    CHECK(contains(r.err, "in 3 steps PCISPH ran out of iterations"));
-    CHECK(contains(r.err, "raise solver.max_iterations"));
-    const auto rows = read_stats(dir + "/stats.csv");
-    REQUIRE(rows.size() == 3);
-    for (const auto& row : rows) {
+    // Each step is tried 7 times and integrated unconverged, and since halving did not rescue
+    // it, the next step starts again from the CFL bound, not from the last halving (which would
+    // divide it by 64 each step).
+    const UnreachableRun u =
+        run_at_unreachable_tolerance("cfl_unreachable", " --set solver.dt_mode=cfl --set solver.eta_max=0");
+    CAPTURE(u.result.err);
+    REQUIRE(u.result.code == 0);
+    CHECK(contains(u.result.err, "in 3 steps PCISPH ran out of iterations"));
+    CHECK(contains(u.result.err, "raise solver.max_iterations"));
+    REQUIRE(u.rows.size() == 3);
+    for (const auto& row : u.rows) {
         CHECK(row.at("unconverged") == 1);
         CHECK(row.at("dt_retries") == 6);
         CHECK(row.at("iterations") == 7 * 3);
         // The step taken is the sixth halving of a step near the first one's: within a factor 2
         // (the CFL bound moves with the speed), not 64 times smaller.
-        CHECK(row.at("dt") > 0.5 * rows.front().at("dt"));
+        CHECK(row.at("dt") > 0.5 * u.rows.front().at("dt"));
     }
 }
 
 TEST_CASE("fixed mode: a step that runs out of iterations is counted, and the run warns once") {
-    // A tolerance no three iterations reach: every step ends unconverged, none is retried.
-    const std::string dir = out_dir("fixed_out_of_iterations");
-    const Result r = run("run " + tiny() + " --steps 3 --out " + dir +
-                         " --set solver.eta=1e-6 --set solver.max_iterations=3 --set 'output.formats=[]'");
-    CAPTURE(r.err);
-    REQUIRE(r.code == 0);
-    CHECK(contains(r.err, "in 3 steps PCISPH ran out of iterations (solver.max_iterations 3)"));
-    CHECK(contains(r.err, "dt_mode \"cfl\""));
-    const auto rows = read_stats(dir + "/stats.csv");
-    REQUIRE(rows.size() == 3);
-    for (const auto& row : rows) {
+    const UnreachableRun u = run_at_unreachable_tolerance("fixed_out_of_iterations", "");
+    CAPTURE(u.result.err);
+    REQUIRE(u.result.code == 0);
+    CHECK(contains(u.result.err, "in 3 steps PCISPH ran out of iterations (solver.max_iterations 3)"));
+    CHECK(contains(u.result.err, "dt_mode \"cfl\""));
+    REQUIRE(u.rows.size() == 3);
+    for (const auto& row : u.rows) {
         CHECK(row.at("unconverged") == 1);
-        CHECK(row.at("dt_retries") == 0);
+        CHECK(row.at("dt_retries") == 0);  // fixed mode never retries
         CHECK(row.at("iterations") == 3);
     }
-    CHECK(read_json(dir + "/summary.json")["unconverged_steps"] == 3);
+    CHECK(u.summary["unconverged_steps"] == 3);
 }
 
 TEST_CASE("guards: particles leaving an open domain are counted and reported") {
