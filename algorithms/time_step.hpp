@@ -77,7 +77,7 @@ class BackendSimulation final : public Simulation {
         //    not see a flat impact, where a whole column must stop at once (docs/solver.md).
         //    So is a step that ran out of iterations above the tolerance: at CFL numbers near 1
         //    such steps (4-5 ms in the dam break) ended at max_iterations with the peak error
-        //    above 100% while the average never doubled (docs/solver.md, "Large CFL numbers").
+        //    above 100% while the average never doubled (docs/solver.md, "Sixteenth session").
         int iterations = 0, retries = 0;  // iterations: of every try of the step
         PcisphOutcome outcome = PcisphOutcome::kConverged;
         DensityError error;

@@ -48,7 +48,6 @@ int report_interrupted_setup() {
     return 130;
 }
 
-// The lost-fluid guard's message: the step, how much fluid left, the limit, and the likely cause.
 // What PCISPH did before a run stopped: the steps integrated after the iteration diverged or ran
 // out of iterations (columns diverged and unconverged of stats.csv), or "" if none.
 std::string failed_iterations_hint(const StatsTable& stats) {
@@ -62,6 +61,7 @@ std::string failed_iterations_hint(const StatsTable& stats) {
            "dt_mode \"cfl\"";
 }
 
+// The lost-fluid guard's message: the step, how much fluid left, the limit, and the likely cause.
 std::string lost_fluid_message(const StepReport& r, long fluid_count, const StatsTable& stats, const Scene& scene) {
     char head[200];
     std::snprintf(head, sizeof head, "step %ld (t = %.6g s): %s of %s (%.3g%%) have left the domain, more than ",
