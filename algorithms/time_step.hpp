@@ -75,9 +75,9 @@ class BackendSimulation final : public Simulation {
         //    In CFL mode a step whose iteration diverges is tried again from the same state at half
         //    the step (nothing before the integration has moved a particle): the CFL bound does
         //    not see a flat impact, where a whole column must stop at once (docs/solver.md).
-        //    So is a step that ran out of iterations above the tolerance: at CFL numbers near 1
-        //    such steps (4-5 ms in the dam break) ended at max_iterations with the peak error
-        //    above 100% while the average never doubled (docs/solver.md, "Sixteenth session").
+        //    So is a step that ran out of iterations above the tolerance: a try that stalls
+        //    short of it (most often under a low max_iterations) is solved at a shorter step,
+        //    not integrated unconverged (docs/solver.md, "Sixteenth session").
         int iterations = 0, retries = 0;  // iterations: of every try of the step
         PcisphOutcome outcome = PcisphOutcome::kConverged;
         DensityError error;

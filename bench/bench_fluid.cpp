@@ -415,15 +415,16 @@ int main(int argc, char** argv) {
                 const char* largest;
             };
             std::vector<WholeRun> runs;
+            SolverParams solver;  // the scene's tolerances, for the title
             for (const StepCase c : {StepCase{"0.4", "0.0015"}, StepCase{"0.4", "0.03"}, StepCase{"0.6", "0.03"},
                                      StepCase{"0.8", "0.03"}, StepCase{"1", "0.03"}}) {
                 const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/dam_break.json",
                                                {std::string("solver.cfl_number=") + c.cfl_number,
                                                 std::string("solver.dt=") + c.largest});
+                solver = scene.params.solver;
                 runs.push_back(run_whole(o, std::string("CFL ") + c.cfl_number + ", largest step " + c.largest + " s",
                                          build_setup(scene), end_time));
             }
-            const SolverParams solver = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/dam_break.json").params.solver;
             char title[200];
             std::snprintf(title, sizeof title,
                           "### Time step (scenes/dam_break.json, %ld fluid particles, to t = %.1f s; eta %g%%, "
