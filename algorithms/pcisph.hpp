@@ -98,9 +98,9 @@ void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count
     });
 }
 
-// x*_i = x_i + Δt v*_i with v*_i = v_i + Δt (a_np + a_p), then the walls' position rule
-// (wall_contact.hpp). Without a non-pressure field, a_np is gravity. A null pressure_acc means no
-// pressure acceleration yet.
+// x*_i = x_i + Δt v*_i with v*_i = v_i + Δt (a_np + a_p), then the position rule of the
+// velocity–position correction (wall_contact.hpp). Without a non-pressure field, a_np is gravity.
+// A null pressure_acc means no pressure acceleration yet.
 inline void predict_positions(std::size_t fluid_count, View<const Vec3> position, View<const Vec3> velocity,
                               const Vec3* nonpressure, const Vec3* pressure_acc, View<Vec3> predicted, Vec3 gravity,
                               Real dt, WallContact walls) {
@@ -169,7 +169,7 @@ void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<co
 }
 
 // Symplectic Euler: v += Δt (a_np + a_p); x += Δt v; then the velocity–position correction
-// against the domain walls (wall_contact.hpp).
+// against the domain walls, the static boxes and static objects (wall_contact.hpp).
 inline void integrate_fluid(std::size_t fluid_count, View<Vec3> position, View<Vec3> velocity, const Vec3* nonpressure,
                             View<const Vec3> pressure_acc, Vec3 gravity, Real dt, WallContact walls) {
     parallel_for("integrate_fluid", fluid_count, [=] MW_HD(std::size_t i) {

@@ -58,14 +58,19 @@ struct SimulationParams {
     // How far outside the faces the walls' first particle layer lies (sampling/wall_gap.hpp), m;
     // negative: not given. Needed with domain_walls when wall_correction is on.
     Real wall_gap = -1;
-    // The velocity–position correction against the domain walls and the static boxes
-    // (algorithms/wall_contact.hpp): fluid moving into them stops about r0 from their first
-    // layer. Off unless asked for, like every physics switch added after the first release; the
-    // shipped scenes with walls ask for it (boundary.correction), and so do the tests' and the
-    // benchmarks' dam breaks built in code, which check what those scenes run.
+    // The velocity–position correction against the domain walls, the static boxes and static
+    // mesh objects (algorithms/wall_contact.hpp): fluid moving into them stops about r0 from the
+    // walls' and boxes' first layer, 0.45 r0 from an object's surface. Off unless asked for, like
+    // every physics switch added after the first release; the shipped scenes with walls ask for
+    // it (boundary.correction), and so do the tests' and the benchmarks' dam breaks built in
+    // code, which check what those scenes run.
     bool wall_correction = false;
     // The static boxes' faces, for that correction (their particles are in the setup's lists).
     std::vector<ContactBox> static_boxes;
+    // Static mesh objects' signed distance grids, for that correction: each object's grid, its
+    // values stored one object after another in static_object_distances (ContactField::field.first).
+    std::vector<ContactField> static_objects;
+    std::vector<Real> static_object_distances;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

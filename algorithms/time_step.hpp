@@ -149,7 +149,8 @@ class BackendSimulation final : public Simulation {
     std::size_t device_bytes() const override {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
                pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
-               contact_boxes_.bytes() + backend_scratch_bytes();
+               contact_boxes_.bytes() + contact_objects_.bytes() + contact_object_distances_.bytes() +
+               backend_scratch_bytes();
     }
     double time() const override { return time_; }
     std::string backend_name() const override { return kBackendName; }
@@ -261,8 +262,10 @@ class BackendSimulation final : public Simulation {
     NeighborGrid grid_;
     NeighborList lists_;
     bool use_lists_ = false;
-    WallContact wall_contact_;  // the velocity–position correction against the domain walls and static boxes
+    WallContact wall_contact_;  // the velocity–position correction against the walls, static boxes and objects
     DeviceArray<ContactBox> contact_boxes_;  // the static boxes' faces, read by wall_contact_
+    DeviceArray<ContactField> contact_objects_;     // static mesh objects' distance grids, read by wall_contact_
+    DeviceArray<Real> contact_object_distances_;    // ... and their values
     DeviceArray<std::uint32_t>* neighbor_count_ = nullptr;  // store field: each particle's list length, sizes next step's row
     GroupRanges ranges_;
     DeviceArray<Real> boundary_volume_;  // V_b, indexed like the store (fluid entries unused)
@@ -353,6 +356,18 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (params_.wall_correction && !params_.static_boxes.empty() && counts_.by_type[kFluid] > 0) {
         contact_boxes_.upload(params_.static_boxes);
         wall_contact_.boxes = contact_boxes_.cview();
+    }
+    if (params_.wall_correction && !params_.static_objects.empty() && counts_.by_type[kFluid] > 0) {
+        std::size_t values = 0;
+        for (const ContactField& c : params_.static_objects)
+            values = std::max(values, std::size_t(c.field.first) + std::size_t(c.field.nx) * std::size_t(c.field.ny) *
+                                                                      std::size_t(c.field.nz));
+        if (values > params_.static_object_distances.size())
+            throw InputError("simulation setup: a static object's distance grid reaches past the values given");
+        contact_objects_.upload(params_.static_objects);
+        contact_object_distances_.upload(params_.static_object_distances);
+        wall_contact_.objects = contact_objects_.cview();
+        wall_contact_.object_distances = contact_object_distances_.cview();
     }
     if (params_.domain_walls && fp.viscosity > 0)
         fluid_.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::kAllFaces, h};

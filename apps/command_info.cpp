@@ -113,13 +113,27 @@ int command_info(int argc, char** argv) {
     else
         std::printf("boundary    no domain walls; %zu static box(es)\n", scene.static_boxes.size());
     const bool boxes = !scene.static_boxes.empty();
-    if ((scene.walls || boxes) && scene.params.wall_correction)
-        std::printf("            velocity-position correction on (boundary.correction): fluid moving into the %s "
-                    "stops about r0 from the boundary layer\n",
-                    scene.walls && boxes ? "walls or a static box" : scene.walls ? "walls" : "static boxes");
-    else if (scene.walls || boxes)
+    const long static_objects = std::count_if(scene.objects.begin(), scene.objects.end(),
+                                              [](const SceneObject& o) { return o.kind == SolidKind::kStatic; });
+    if ((scene.walls || boxes || static_objects) && scene.params.wall_correction) {
+        // What the correction covers, and where it stops the fluid (algorithms/wall_contact.hpp).
+        std::string covered;
+        auto add = [&](const std::string& part) { covered += (covered.empty() ? "" : ", ") + part; };
+        if (scene.walls) add("about r0 from the walls' layer");
+        if (boxes) add("about r0 from a static box");
+        if (static_objects) {
+            char part[96];
+            std::snprintf(part, sizeof part, "%.2g r0 from a static object's surface (%ld object(s))",
+                          kStaticObjectContact, static_objects);
+            add(part);
+        }
+        std::printf("            velocity-position correction on (boundary.correction): fluid moving into a "
+                    "boundary stops %s\n",
+                    covered.c_str());
+    } else if (scene.walls || boxes || static_objects) {
         std::printf("            velocity-position correction off (boundary.correction false): only the Akinci "
                     "layers hold the fluid in\n");
+    }
     if (const std::string warning = scene.kernel_warning(); !warning.empty())
         std::printf("warning     %s\n", warning.c_str());
     return 0;

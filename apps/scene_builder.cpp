@@ -10,6 +10,7 @@
 #include "sampling/inside_outside.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
+#include "sampling/signed_distance.hpp"
 #include "sampling/solid_sample.hpp"
 #include "sampling/wall_gap.hpp"
 
@@ -229,6 +230,10 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             const std::size_t first = setup.position.size();
             const std::size_t inner = add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
                                                        scene.params.fluid.support_radius, pinned);
+            // Fluid moving into a static object is stopped by its signed distance (only where the
+            // correction is on and there is fluid to stop).
+            if (o.kind == SolidKind::kStatic && scene.params.wall_correction && !scene.fluid_blocks.empty())
+                add_static_object_distance(setup, object.mesh, scene.params.fluid.spacing);
             for (std::size_t i = first; check_overlaps && i < first + inner; ++i) {
                 const Vec3 x = setup.position[i];
                 object.inner.emplace_back(x.x, x.y, x.z);
@@ -363,6 +368,24 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
     }
     setup.solids.push_back(std::move(solid));
     return sample.ibp.count();
+}
+
+void add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0) {
+    const double contact = kStaticObjectContact * r0, spacing = r0 / 2;
+    const SignedDistanceGrid sdf = signed_distance_grid(mesh, spacing, contact + 2 * spacing, kMaxObjectDistanceNodes);
+    std::vector<Real>& values = setup.params.static_object_distances;
+    ContactField c;
+    c.contact = Real(contact);
+    c.field.origin = Vec3{Real(sdf.grid.origin.x()), Real(sdf.grid.origin.y()), Real(sdf.grid.origin.z())};
+    c.field.inv_spacing = Real(1 / sdf.grid.spacing);
+    c.field.nx = sdf.grid.dims[0];
+    c.field.ny = sdf.grid.dims[1];
+    c.field.nz = sdf.grid.dims[2];
+    c.field.first = static_cast<std::uint32_t>(values.size());
+    if (values.size() + sdf.distance.size() > std::size_t(UINT32_MAX))
+        throw InputError("the static objects' distance grids hold more than 2^32 values; increase fluid.spacing");
+    for (double d : sdf.distance) values.push_back(Real(d));
+    setup.params.static_objects.push_back(c);
 }
 
 ParticleCounts count_particles(const SimulationSetup& setup) {

@@ -46,6 +46,13 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
                       std::int32_t object_id, double r0, double h,
                       const std::function<bool(const Vec3&)>& pinned = nullptr);
 
+// The correction's signed distance grid of a static mesh object (algorithms/wall_contact.hpp),
+// appended to setup.params (static_objects, static_object_distances): at spacing r0/2, reaching
+// the band and two nodes past it outside the mesh's bounding box, at most
+// kMaxObjectDistanceNodes nodes (coarser beyond that).
+constexpr std::size_t kMaxObjectDistanceNodes = 8'000'000;
+void add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0);
+
 // The mesh of a scene object in world coordinates (file or procedural, then the transform).
 TriangleMesh object_mesh(const Scene& scene, const SceneObject& object);
 

@@ -4,12 +4,16 @@
 #include <cstddef>
 #include <cstdint>
 
+// MW_INLINE is a hint to the host compiler; MW_ALWAYS_INLINE insists, for the few small functions
+// on a per-particle path that g++ otherwise calls out of line (wall_contact.hpp says what it cost).
 #if defined(__CUDACC__)
 #define MW_HD __host__ __device__
 #define MW_INLINE __host__ __device__ __forceinline__
+#define MW_ALWAYS_INLINE __host__ __device__ __forceinline__
 #else
 #define MW_HD
 #define MW_INLINE inline
+#define MW_ALWAYS_INLINE inline __attribute__((always_inline))
 #endif
 
 namespace mw {

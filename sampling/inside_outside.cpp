@@ -15,6 +15,7 @@
 #include <omp.h>
 
 #include "backend/errors.hpp"
+#include "sampling/embree_mesh.hpp"
 #include "sampling/first_exception.hpp"
 #include "sampling/winding_number.hpp"
 
@@ -60,56 +61,16 @@ void collect_all_hits(const RTCFilterFunctionNArguments* args) {
 // range (Embree asserts |origin| < 1.8e18) while allowing any line a caller can sensibly ask for.
 constexpr double kMaxRayStart = 1e6;
 
-// An Embree device and scene over one mesh. Vertices are stored as floats relative to the
-// bounding-box centre so that meshes far from the origin keep their precision, and divided by
-// a power of two close to the mesh's size: Embree's triangle test multiplies three coordinates
-// together in single precision, which overflows for meshes larger than about 1e12 and underflows
-// for ones smaller than about 1e-12 in their own units. A power of two scales every float
-// operation exactly, so meshes of ordinary size get bit-for-bit the crossings they had unscaled.
+// The ray caster over one mesh (embree_mesh.hpp holds the Embree scene and its coordinates).
 class EmbreeScene {
 public:
-    explicit EmbreeScene(const TriangleMesh& mesh) {
-        const Aabb box = bounding_box(mesh);
-        center_ = box.center();
-        const double diagonal = box.extent().norm();
-        reach_ = diagonal > 0 && std::isfinite(diagonal) ? diagonal : 1.0;
-        unit_ = std::ldexp(1.0, std::ilogb(reach_));
-        // Embree builds its tree on its own (TBB) threads, every core by default: held to the
-        // OpenMP thread count, so that `--threads` bounds the whole sampler.
-        const std::string config = "verbose=0,threads=" + std::to_string(omp_get_max_threads());
-        device_ = rtcNewDevice(config.c_str());
-        if (!device_) throw std::runtime_error("Embree: cannot create a device");
-        scene_ = rtcNewScene(device_);
-        rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
-        rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
-        RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        float* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                               3 * sizeof(float), mesh.vertices.size()));
-        for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-            const Vec3d p = (mesh.vertices[i] - center_) / unit_;
-            v[3 * i] = float(p.x());
-            v[3 * i + 1] = float(p.y());
-            v[3 * i + 2] = float(p.z());
-        }
-        unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                       3 * sizeof(unsigned), mesh.triangles.size()));
-        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-            for (int k = 0; k < 3; ++k) idx[3 * t + k] = static_cast<unsigned>(mesh.triangles[t][k]);
-        rtcSetGeometryIntersectFilterFunction(geom, collect_all_hits);
-        rtcCommitGeometry(geom);
-        rtcAttachGeometry(scene_, geom);
-        rtcReleaseGeometry(geom);
-        rtcCommitScene(scene_);
-        if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) {
-            release();
-            throw std::runtime_error("Embree: building the scene failed");
-        }
+    explicit EmbreeScene(const TriangleMesh& mesh) : embree_(mesh, collect_all_hits) {
+        reach_ = embree_.reach();
+        unit_ = embree_.unit();
+        center_ = embree_.center();
         normals_.resize(mesh.triangles.size());
         for (std::size_t t = 0; t < mesh.triangles.size(); ++t) normals_[t] = triangle_normal(mesh, t);
     }
-    ~EmbreeScene() { release(); }
-    EmbreeScene(const EmbreeScene&) = delete;
-    EmbreeScene& operator=(const EmbreeScene&) = delete;
 
     double reach() const { return reach_; }
 
@@ -146,7 +107,7 @@ public:
         rtcInitIntersectContext(&collector.context);
         collector.hits = &hits;
         collector.out_of_memory = false;
-        rtcIntersect1(scene_, &collector.context, &rh);
+        rtcIntersect1(embree_.scene(), &collector.context, &rh);
         if (collector.out_of_memory) throw std::bad_alloc();
         // A hit at an infinite or NaN distance (the triangle test overflowed) locates nothing, and
         // NaN would also break the ordering below: such hits are dropped.
@@ -184,14 +145,7 @@ public:
     }
 
 private:
-    void release() {
-        if (scene_) rtcReleaseScene(scene_);
-        if (device_) rtcReleaseDevice(device_);
-        scene_ = nullptr;
-        device_ = nullptr;
-    }
-    RTCDevice device_ = nullptr;
-    RTCScene scene_ = nullptr;
+    EmbreeMesh embree_;
     Vec3d center_;
     std::vector<Vec3d> normals_;
     double reach_ = 1;  // bounding-box diagonal

@@ -293,13 +293,18 @@ TEST_CASE("info: the kernel, and a warning for the cubic spline at a support it 
     CHECK(contains(summary["warnings"][0].get<std::string>(), "pairing instability"));
 }
 
-TEST_CASE("info: the walls' velocity-position correction, on in the default scene, named with what it covers") {
+TEST_CASE("info: the velocity-position correction, on in the default scene, named with what it covers") {
     const Result on = run("info");
     REQUIRE(on.code == 0);
-    CHECK(contains(on.out, "velocity-position correction on (boundary.correction): fluid moving into the walls stops"));
+    CHECK(contains(on.out, "velocity-position correction on (boundary.correction): fluid moving into a boundary stops "
+                           "about r0 from the walls' layer\n"));
     const Result boxes = run("info --set boundary.walls=false --set 'static_boxes=[{\"min\":[1,0,0.3],\"max\":[1.2,0.2,0.5]}]'");
     REQUIRE(boxes.code == 0);
-    CHECK(contains(boxes.out, "fluid moving into the static boxes stops"));
+    CHECK(contains(boxes.out, "fluid moving into a boundary stops about r0 from a static box\n"));
+    const Result objects = run("info --set 'objects=[{\"mesh\":{\"procedural\":\"sphere:radius=0.1\"},"
+                               "\"transform\":{\"translation\":[1.2,0.3,0.4]},\"kind\":\"static\"}]'");
+    REQUIRE(objects.code == 0);
+    CHECK(contains(objects.out, "about r0 from the walls' layer, 0.45 r0 from a static object's surface (1 object(s))"));
     const Result off = run("info --set boundary.correction=false");
     REQUIRE(off.code == 0);
     CHECK(contains(off.out, "velocity-position correction off"));

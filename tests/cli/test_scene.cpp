@@ -284,6 +284,37 @@ TEST_CASE("static boxes and objects carve the fluid: none is left inside them or
     }
 }
 
+TEST_CASE("a static object gets a signed distance grid for the correction only where the correction can act") {
+    const std::string object =
+        R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "transform": {"translation": [0.15, 0.1, 0.1]},
+                        "kind": "static"}])";
+    const SimulationSetup on = build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=true"}));
+    REQUIRE(on.params.static_objects.size() == 1);
+    const ContactField& c = on.params.static_objects[0];
+    const Real r0 = 0.02f;
+    CHECK(c.contact == doctest::Approx(kStaticObjectContact * r0));
+    CHECK(c.field.first == 0);
+    CHECK(on.params.static_object_distances.size() == std::size_t(c.field.nx) * c.field.ny * c.field.nz);
+    CHECK(1 / c.field.inv_spacing == doctest::Approx(r0 / 2));
+    // The grid reaches past the band and one more cell beyond the sphere on every side.
+    CHECK(c.field.origin.x <= 0.15f - 0.03f - c.contact - r0 / 2);
+    CHECK(c.field.origin.x + (c.field.nx - 1) / c.field.inv_spacing >= 0.15f + 0.03f + c.contact + r0 / 2);
+    // Negative at the centre, about the radius deep.
+    Real d = 0;
+    Vec3 g{0, 0, 0};
+    REQUIRE(c.field.sample(View<const Real>{on.params.static_object_distances.data(),
+                                            on.params.static_object_distances.size()},
+                           Vec3{0.15f, 0.1f, 0.1f}, d, g));
+    CHECK(d == doctest::Approx(-0.03).epsilon(0.05));
+    // None without the correction, for a moving object, or with no fluid to correct.
+    CHECK(build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=false"}))
+              .params.static_objects.empty());
+    CHECK(build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=true", "objects.0.kind=\"rigid\""}))
+              .params.static_objects.empty());
+    CHECK(build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=true", "fluid_blocks=[]"}))
+              .params.static_objects.empty());
+}
+
 // h a rounding error above r0 passes the scene's range (r0, 4 r0] but leaves no wall placement
 // that gives the fluid its rest density (sampling/wall_gap.hpp): refused at set-up, naming the key.
 TEST_CASE("a support radius within rounding of the spacing is refused, naming the key") {

@@ -167,8 +167,8 @@ TEST_CASE("CUDA and OpenMP agree on fluid around a moving solid: a cube thrown i
         MW_SKIP(cuda_backend_info().description);
         return;
     }
-    for (const auto lists : {SimulationParams::Lists::kOff, SimulationParams::Lists::kOn}) {
-        const std::string variant = lists == SimulationParams::Lists::kOn ? "neighbour lists" : "grid gathers";
+    for (const auto lists : test::kGatherModes) {
+        const std::string variant = test::gather_mode_name(lists);
         CAPTURE(variant);
         const SimulationSetup setup = cube_into_pool(lists);
         const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 40);

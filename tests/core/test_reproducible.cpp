@@ -71,8 +71,8 @@ TEST_CASE("CUDA against CUDA: two runs are bitwise identical (grid gathers and n
         MW_SKIP(cuda_backend_info().description);
         return;
     }
-    for (const auto lists : {SimulationParams::Lists::kOff, SimulationParams::Lists::kOn}) {
-        CAPTURE(lists == SimulationParams::Lists::kOn);
+    for (const auto lists : test::kGatherModes) {
+        CAPTURE(test::gather_mode_name(lists));
         SimulationSetup setup = small_dam_break();
         setup.params.neighbor_lists = lists;
         const HostParticles first = test::run_steps(*create_cuda_simulation(setup), 50);

@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "algorithms/simulation.hpp"
@@ -107,6 +108,13 @@ inline OpenmpAndCuda run_openmp_and_cuda(const SimulationSetup& setup, int steps
     out.cuda = run_steps(*gpu, steps);
     out.cuda_report = gpu->last_report();
     return out;
+}
+
+// The two ways PCISPH can gather neighbours (per-step lists, or the grid in every iteration), and
+// their names for test messages: cross-backend tests run both.
+constexpr SimulationParams::Lists kGatherModes[] = {SimulationParams::Lists::kOff, SimulationParams::Lists::kOn};
+inline std::string gather_mode_name(SimulationParams::Lists lists) {
+    return lists == SimulationParams::Lists::kOn ? "neighbour lists" : "grid gathers";
 }
 
 // The largest distance |a.position[i] - b.position[i]| between two runs of the same setup, over the
