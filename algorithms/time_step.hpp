@@ -359,9 +359,13 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     }
     if (params_.wall_correction && !params_.static_objects.empty() && counts_.by_type[kFluid] > 0) {
         std::size_t values = 0;
-        for (const ContactField& c : params_.static_objects)
+        for (const ContactField& c : params_.static_objects) {
+            if (c.field.nx < 2 || c.field.ny < 2 || c.field.nz < 2 || !(c.field.inv_spacing > 0))
+                throw InputError("simulation setup: a static object's distance grid needs 2 nodes or more per axis "
+                                 "and a positive spacing");
             values = std::max(values, std::size_t(c.field.first) + std::size_t(c.field.nx) * std::size_t(c.field.ny) *
                                                                       std::size_t(c.field.nz));
+        }
         if (values > params_.static_object_distances.size())
             throw InputError("simulation setup: a static object's distance grid reaches past the values given");
         contact_objects_.upload(params_.static_objects);

@@ -113,23 +113,38 @@ int command_info(int argc, char** argv) {
     else
         std::printf("boundary    no domain walls; %zu static box(es)\n", scene.static_boxes.size());
     const bool boxes = !scene.static_boxes.empty();
-    const long static_objects = std::count_if(scene.objects.begin(), scene.objects.end(),
-                                              [](const SceneObject& o) { return o.kind == SolidKind::kStatic; });
+    // Static objects the correction covers: those with a distance grid (none without fluid).
+    const long static_objects = long(setup.params.static_objects.size());
     if ((scene.walls || boxes || static_objects) && scene.params.wall_correction) {
         // What the correction covers, and where it stops the fluid (algorithms/wall_contact.hpp).
-        std::string covered;
+        std::string covered, coarse_grid_warning;
         auto add = [&](const std::string& part) { covered += (covered.empty() ? "" : ", ") + part; };
         if (scene.walls) add("about r0 from the walls' layer");
         if (boxes) add("about r0 from a static box");
         if (static_objects) {
-            char part[96];
-            std::snprintf(part, sizeof part, "%.2g r0 from a static object's surface (%ld object(s))",
-                          kStaticObjectContact, static_objects);
+            std::size_t nodes = 0;
+            double coarsest = 0;
+            for (const ContactField& c : setup.params.static_objects) {
+                nodes += std::size_t(c.field.nx) * std::size_t(c.field.ny) * std::size_t(c.field.nz);
+                coarsest = std::max(coarsest, 1 / double(c.field.inv_spacing));
+            }
+            char part[200];
+            std::snprintf(part, sizeof part,
+                          "%.2g r0 from a static object's surface (%ld object(s); distance grids of %zu nodes, "
+                          "%.1f MiB, spacing up to %.3g r0)",
+                          kStaticObjectContact, static_objects, nodes, double(nodes * sizeof(Real)) / (1 << 20),
+                          coarsest / double(f.spacing));
             add(part);
+            if (coarsest > 0.5 * double(f.spacing) * (1 + 1e-6))
+                coarse_grid_warning = "a static object's distance grid is coarser than r0/2 (" +
+                                      std::to_string(coarsest / double(f.spacing)) +
+                                      " r0: more than " + std::to_string(kMaxObjectDistanceNodes) +
+                                      " nodes at r0/2), so the correction is less exact at its edges";
         }
         std::printf("            velocity-position correction on (boundary.correction): fluid moving into a "
                     "boundary stops %s\n",
                     covered.c_str());
+        if (!coarse_grid_warning.empty()) std::printf("warning     %s\n", coarse_grid_warning.c_str());
     } else if (scene.walls || boxes || static_objects) {
         std::printf("            velocity-position correction off (boundary.correction false): only the Akinci "
                     "layers hold the fluid in\n");

@@ -233,7 +233,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             // Fluid moving into a static object is stopped by its signed distance (only where the
             // correction is on and there is fluid to stop).
             if (o.kind == SolidKind::kStatic && scene.params.wall_correction && !scene.fluid_blocks.empty())
-                add_static_object_distance(setup, object.mesh, scene.params.fluid.spacing);
+                add_static_object_distance(setup, object.mesh, scene.params.fluid.spacing, sealed_faces(scene));
             for (std::size_t i = first; check_overlaps && i < first + inner; ++i) {
                 const Vec3 x = setup.position[i];
                 object.inner.emplace_back(x.x, x.y, x.z);
@@ -370,10 +370,13 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
     return sample.ibp.count();
 }
 
-void add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0) {
-    const double contact = kStaticObjectContact * r0, spacing = r0 / 2;
-    const SignedDistanceGrid sdf = signed_distance_grid(mesh, spacing, contact + 2 * spacing, kMaxObjectDistanceNodes);
+bool add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0, const SealedFace& sealed) {
+    const double contact = kStaticObjectContact * r0;
+    const SignedDistanceGrid sdf = signed_distance_grid(mesh, r0 / 2, contact, kMaxObjectDistanceNodes, sealed);
+    if (sdf.exit_triangles == 0) return false;
     std::vector<Real>& values = setup.params.static_object_distances;
+    if (values.size() + sdf.distance.size() > std::size_t(UINT32_MAX))
+        throw InputError("the static objects' distance grids hold more than 2^32 values; increase fluid.spacing");
     ContactField c;
     c.contact = Real(contact);
     c.field.origin = Vec3{Real(sdf.grid.origin.x()), Real(sdf.grid.origin.y()), Real(sdf.grid.origin.z())};
@@ -382,10 +385,30 @@ void add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh
     c.field.ny = sdf.grid.dims[1];
     c.field.nz = sdf.grid.dims[2];
     c.field.first = static_cast<std::uint32_t>(values.size());
-    if (values.size() + sdf.distance.size() > std::size_t(UINT32_MAX))
-        throw InputError("the static objects' distance grids hold more than 2^32 values; increase fluid.spacing");
     for (double d : sdf.distance) values.push_back(Real(d));
     setup.params.static_objects.push_back(c);
+    return true;
+}
+
+SealedFace sealed_faces(const Scene& scene) {
+    // A thousandth of r0: a face meant to stand on the floor or a box lies there to rounding.
+    const double tolerance = 1e-3 * double(scene.params.fluid.spacing);
+    const bool walls = scene.walls;
+    const Vec3d lo(scene.params.domain_min.x, scene.params.domain_min.y, scene.params.domain_min.z);
+    const Vec3d hi(scene.params.domain_max.x, scene.params.domain_max.y, scene.params.domain_max.z);
+    std::vector<Eigen::AlignedBox3d> boxes;
+    for (const StaticBox& b : scene.static_boxes)
+        boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z) - Vec3d::Constant(tolerance),
+                           Vec3d(b.max.x, b.max.y, b.max.z) + Vec3d::Constant(tolerance));
+    return [=](const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+        for (int axis = 0; walls && axis < 3; ++axis) {
+            if (std::max({a[axis], b[axis], c[axis]}) <= lo[axis] + tolerance) return true;
+            if (std::min({a[axis], b[axis], c[axis]}) >= hi[axis] - tolerance) return true;
+        }
+        for (const Eigen::AlignedBox3d& box : boxes)
+            if (box.contains(a) && box.contains(b) && box.contains(c)) return true;
+        return false;
+    };
 }
 
 ParticleCounts count_particles(const SimulationSetup& setup) {

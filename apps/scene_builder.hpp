@@ -9,6 +9,7 @@
 #include "apps/scene.hpp"
 #include "sampling/fluid_clearance.hpp"
 #include "sampling/mesh.hpp"
+#include "sampling/signed_distance.hpp"
 
 namespace mw {
 
@@ -49,9 +50,17 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
 // The correction's signed distance grid of a static mesh object (algorithms/wall_contact.hpp),
 // appended to setup.params (static_objects, static_object_distances): at spacing r0/2, reaching
 // the band and two nodes past it outside the mesh's bounding box, at most
-// kMaxObjectDistanceNodes nodes (coarser beyond that).
+// kMaxObjectDistanceNodes nodes (coarser beyond that). `sealed` marks the triangles that are no
+// way out (sampling/signed_distance.hpp); an object whose triangles are all sealed gets no grid.
+// Returns whether a grid was added.
 constexpr std::size_t kMaxObjectDistanceNodes = 8'000'000;
-void add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0);
+bool add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0,
+                                const SealedFace& sealed = nullptr);
+
+// The triangles of a scene's static objects that fluid cannot reach from outside, and so that
+// are no way out of them: those lying on (or beyond) a face of the domain when it has walls, and
+// those inside (or on) a static box.
+SealedFace sealed_faces(const Scene& scene);
 
 // The mesh of a scene object in world coordinates (file or procedural, then the transform).
 TriangleMesh object_mesh(const Scene& scene, const SceneObject& object);

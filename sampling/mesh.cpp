@@ -154,6 +154,25 @@ void flip_orientation(TriangleMesh& mesh) {
     for (auto& tri : mesh.triangles) std::swap(tri[1], tri[2]);
 }
 
+TriangleMesh without_unused_vertices(const TriangleMesh& mesh) {
+    TriangleMesh out;
+    out.source = mesh.source;
+    std::vector<int> new_index(mesh.vertices.size(), -1);
+    for (const auto& tri : mesh.triangles) {
+        std::array<int, 3> renumbered;
+        for (int k = 0; k < 3; ++k) {
+            int& id = new_index[static_cast<std::size_t>(tri[k])];
+            if (id < 0) {
+                id = static_cast<int>(out.vertices.size());
+                out.vertices.push_back(mesh.vertices[static_cast<std::size_t>(tri[k])]);
+            }
+            renumbered[k] = id;
+        }
+        out.triangles.push_back(renumbered);
+    }
+    return out;
+}
+
 void validate_mesh(const TriangleMesh& mesh, bool require_volume) {
     const std::string src = describe(mesh);
     if (mesh.triangles.empty()) throw InputError(src + ": the mesh has no triangles");

@@ -70,6 +70,9 @@ struct EdgeReport {
 };
 EdgeReport edge_report(const TriangleMesh& mesh);
 void flip_orientation(TriangleMesh& mesh);
+// The same triangles over only the vertices they use (renumbered in order of first use). Indices
+// must be in range (validate_mesh).
+TriangleMesh without_unused_vertices(const TriangleMesh& mesh);
 
 // Checks that the mesh can be sampled: at least one triangle, finite vertices within
 // ±kMaxCoordinate, indices in range, not farther than kMaxDistanceInMeshSizes of its sizes from

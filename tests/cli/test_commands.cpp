@@ -304,7 +304,10 @@ TEST_CASE("info: the velocity-position correction, on in the default scene, name
     const Result objects = run("info --set 'objects=[{\"mesh\":{\"procedural\":\"sphere:radius=0.1\"},"
                                "\"transform\":{\"translation\":[1.2,0.3,0.4]},\"kind\":\"static\"}]'");
     REQUIRE(objects.code == 0);
-    CHECK(contains(objects.out, "about r0 from the walls' layer, 0.45 r0 from a static object's surface (1 object(s))"));
+    CHECK(contains(objects.out, "about r0 from the walls' layer, 0.45 r0 from a static object's surface (1 object(s); "
+                                "distance grids of "));
+    CHECK(contains(objects.out, "spacing up to 0.5 r0)\n"));
+    CHECK(!contains(objects.out, "coarser than r0/2"));
     const Result off = run("info --set boundary.correction=false");
     REQUIRE(off.code == 0);
     CHECK(contains(off.out, "velocity-position correction off"));

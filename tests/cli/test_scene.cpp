@@ -305,7 +305,24 @@ TEST_CASE("a static object gets a signed distance grid for the correction only w
     REQUIRE(c.field.sample(View<const Real>{on.params.static_object_distances.data(),
                                             on.params.static_object_distances.size()},
                            Vec3{0.15f, 0.1f, 0.1f}, d, g));
-    CHECK(d == doctest::Approx(-0.03).epsilon(0.05));
+    CHECK(std::abs(d + 0.03f) < 0.0015f);  // the icosphere's facets lie a little inside the sphere
+    // Two objects: the second grid's values follow the first's.
+    const std::string two =
+        R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "transform": {"translation": [0.15, 0.1, 0.1]},
+                        "kind": "static"},
+                       {"mesh": {"procedural": "box:x=0.04,y=0.04,z=0.04"}, "transform": {"translation": [0.15, 0.15, 0.15]},
+                        "kind": "static"}])";
+    const SimulationSetup both = build_setup(parse_scene_text(tiny_scene_text(two), "t", {"boundary.correction=true"}));
+    REQUIRE(both.params.static_objects.size() == 2);
+    const ContactField& second = both.params.static_objects[1];
+    CHECK(second.field.first == std::uint32_t(c.field.nx * c.field.ny * c.field.nz));
+    CHECK(both.params.static_object_distances.size() ==
+          second.field.first + std::size_t(second.field.nx) * second.field.ny * second.field.nz);
+    const View<const Real> values{both.params.static_object_distances.data(), both.params.static_object_distances.size()};
+    REQUIRE(second.field.sample(values, Vec3{0.15f, 0.15f, 0.15f}, d, g));
+    CHECK(std::abs(d + 0.02f) < 1e-4f);  // the box's centre, 0.02 m from each face
+    REQUIRE(both.params.static_objects[0].field.sample(values, Vec3{0.15f, 0.1f, 0.1f}, d, g));
+    CHECK(std::abs(d + 0.03f) < 0.0015f);
     // None without the correction, for a moving object, or with no fluid to correct.
     CHECK(build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=false"}))
               .params.static_objects.empty());

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include <doctest/doctest.h>
 
@@ -59,8 +60,8 @@ TEST_CASE("signed distance grid of a box: every node equals the box's exact sign
     const Vec3d size(0.3, 0.1, 0.2);
     TriangleMesh box = make_box(size);
     const Vec3d lo = -0.5 * size, hi = 0.5 * size;
-    const double spacing = 0.01, margin = 0.03;
-    const SignedDistanceGrid sdf = signed_distance_grid(box, spacing, margin, 0);
+    const double spacing = 0.01, band = 0.01, margin = band + 2 * spacing;
+    const SignedDistanceGrid sdf = signed_distance_grid(box, spacing, band, 0);
     REQUIRE(sdf.distance.size() == sdf.grid.count());
     CHECK(sdf.grid.spacing == spacing);
     // The grid reaches the margin past the box on every side.
@@ -81,15 +82,15 @@ TEST_CASE("signed distance grid of a box: every node equals the box's exact sign
 
     // An inward-oriented copy gives the same field: the builder orients meshes outward first.
     flip_orientation(box);
-    const SignedDistanceGrid flipped = signed_distance_grid(box, spacing, margin, 0);
+    const SignedDistanceGrid flipped = signed_distance_grid(box, spacing, band, 0);
     CHECK(flipped.distance == sdf.distance);
 }
 
 TEST_CASE("signed distance grid of a sphere mesh: exact distances to its triangles, signed by the winding number") {
     const double radius = 0.12;
     const TriangleMesh sphere = make_sphere(radius, 3);
-    const double margin = 0.02;
-    const SignedDistanceGrid sdf = signed_distance_grid(sphere, 0.01, margin, 0);
+    const double margin = 0.02;  // no band: two nodes
+    const SignedDistanceGrid sdf = signed_distance_grid(sphere, 0.01, 0, 0);
     double longest_edge = 0;
     for (std::size_t t = 0; t < sphere.triangle_count(); ++t)
         longest_edge = std::max(longest_edge, (sphere.corner(t, 0) - sphere.corner(t, 1)).norm());
@@ -134,7 +135,52 @@ TEST_CASE("signed distance grid: a node budget coarsens the grid to fit it") {
     CHECK(capped.grid.count() <= 4000);
     CHECK(capped.grid.count() > 2000);  // not coarser than it has to be
     CHECK(capped.grid.spacing > 0.05);
-    for (int a = 0; a < 3; ++a) CHECK(capped.grid.origin[a] <= -0.5 - 0.1 + 1e-12);
+    // The band and two of the coarser nodes past the box.
+    for (int a = 0; a < 3; ++a) CHECK(capped.grid.origin[a] <= -0.5 - 0.1 - 2 * capped.grid.spacing + 1e-12);
+    // A budget too small for any grid, or nonsense arguments, are refused.
+    CHECK_THROWS_AS(signed_distance_grid(box, 0.05, 0.1, 7), std::invalid_argument);
+    CHECK_THROWS_AS(signed_distance_grid(box, 0, 0.1, 0), std::invalid_argument);
+}
+
+TEST_CASE("signed distance grid: vertices no triangle uses are ignored") {
+    TriangleMesh box = make_box(Vec3d(0.2, 0.2, 0.2));
+    const SignedDistanceGrid clean = signed_distance_grid(box, 0.02, 0.02, 0);
+    box.vertices.push_back(Vec3d(0.2, 0, 0));  // 0.1 m off the +x face, in no triangle
+    const SignedDistanceGrid stray = signed_distance_grid(box, 0.02, 0.02, 0);
+    CHECK(stray.grid.dims == clean.grid.dims);
+    CHECK(stray.distance == clean.distance);
+}
+
+TEST_CASE("signed distance grid: sealed faces are no way out, but still tell inside from outside") {
+    // A 0.2 m cube standing on the plane y = -0.1 (its bottom face), that face sealed.
+    const TriangleMesh box = make_box(Vec3d(0.2, 0.2, 0.2));
+    const SealedFace on_floor = [](const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+        return std::max({a.y(), b.y(), c.y()}) <= -0.1 + 1e-9;
+    };
+    const SignedDistanceGrid sdf = signed_distance_grid(box, 0.01, 0.01, 0, on_floor);
+    CHECK(sdf.exit_triangles == 10);  // 12 less the bottom's two
+    const Vec3d lo(-0.1, -0.1, -0.1), hi(0.1, 0.1, 0.1);
+    double worst_inside = 0, worst_outside = 0;
+    for (std::size_t id = 0; id < sdf.grid.count(); ++id) {
+        const Vec3d p = node(sdf.grid, id);
+        if (p.y() < lo.y() + 1e-9) continue;  // on or below the floor: no fluid there
+        const double exact = box_distance(p, lo, hi);
+        if (exact >= 0) {
+            worst_outside = std::max(worst_outside, std::abs(sdf.distance[id] - exact));
+        } else {
+            // Inside: the distance to the sides and the top only.
+            const double to_exit =
+                std::min({p.x() - lo.x(), hi.x() - p.x(), p.z() - lo.z(), hi.z() - p.z(), hi.y() - p.y()});
+            worst_inside = std::max(worst_inside, std::abs(sdf.distance[id] + to_exit));
+        }
+    }
+    CHECK(worst_inside < 1e-12);
+    CHECK(worst_outside < 1e-12);
+    // Every face sealed: no grid.
+    const SignedDistanceGrid none =
+        signed_distance_grid(box, 0.01, 0.01, 0, [](const Vec3d&, const Vec3d&, const Vec3d&) { return true; });
+    CHECK(none.exit_triangles == 0);
+    CHECK(none.distance.empty());
 }
 
 TEST_CASE("signed distance grid: a broken mesh is an InputError naming it") {
@@ -150,7 +196,7 @@ TEST_CASE("signed distance grid of an open scan (the bunny): the sign follows th
     const TriangleMesh bunny = load_obj(mwtest::mesh_dir() + "/stanford-bunny.obj");
     const Aabb box = bounding_box(bunny);
     const double spacing = box.extent().maxCoeff() / 30;
-    const SignedDistanceGrid sdf = signed_distance_grid(bunny, spacing, 2 * spacing, 0);
+    const SignedDistanceGrid sdf = signed_distance_grid(bunny, spacing, 0, 0);
     std::mt19937 rng(3);
     std::uniform_int_distribution<std::size_t> pick(0, sdf.grid.count() - 1);
     int agree = 0, total = 0;
