@@ -145,7 +145,9 @@ int command_info(int argc, char** argv) {
                     "boundary stops %s\n",
                     covered.c_str());
         if (!coarse_grid_warning.empty()) std::printf("warning     %s\n", coarse_grid_warning.c_str());
-    } else if (scene.walls || boxes || static_objects) {
+    } else if (scene.walls || boxes ||
+               std::any_of(scene.objects.begin(), scene.objects.end(),
+                           [](const SceneObject& o) { return o.kind == SolidKind::kStatic; })) {
         std::printf("            velocity-position correction off (boundary.correction false): only the Akinci "
                     "layers hold the fluid in\n");
     }

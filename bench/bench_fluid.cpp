@@ -171,6 +171,18 @@ struct WholeRun {
     }
 };
 
+// A CFL number and a largest step, applied to a shipped scene as overrides: the whole-run
+// sections' cases.
+struct StepCase {
+    const char* cfl_number;
+    const char* largest;
+    std::string name() const { return std::string("CFL ") + cfl_number + ", largest step " + largest + " s"; }
+};
+Scene scene_at_step(const char* scene_file, StepCase c) {
+    return load_scene(std::string(MW_SOURCE_DIR) + "/scenes/" + scene_file,
+                      {std::string("solver.cfl_number=") + c.cfl_number, std::string("solver.dt=") + c.largest});
+}
+
 // Called after every step of a whole run (to look at the particles).
 using StepObserver = std::function<void(Simulation&, WholeRun&)>;
 
@@ -422,20 +434,13 @@ int main(int argc, char** argv) {
         // iterations).
         if (o.wants("steps")) {
             const double end_time = o.quick ? 0.5 : 1.5;
-            struct StepCase {
-                const char* cfl_number;
-                const char* largest;
-            };
             std::vector<WholeRun> runs;
             SolverParams solver;  // the scene's tolerances, for the title
             for (const StepCase c : {StepCase{"0.4", "0.0015"}, StepCase{"0.4", "0.03"}, StepCase{"0.6", "0.03"},
                                      StepCase{"0.8", "0.03"}, StepCase{"1", "0.03"}}) {
-                const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/dam_break.json",
-                                               {std::string("solver.cfl_number=") + c.cfl_number,
-                                                std::string("solver.dt=") + c.largest});
+                const Scene scene = scene_at_step("dam_break.json", c);
                 solver = scene.params.solver;
-                runs.push_back(run_whole(o, std::string("CFL ") + c.cfl_number + ", largest step " + c.largest + " s",
-                                         build_setup(scene), end_time));
+                runs.push_back(run_whole(o, c.name(), build_setup(scene), end_time));
             }
             char title[200];
             std::snprintf(title, sizeof title,
@@ -446,23 +451,16 @@ int main(int argc, char** argv) {
                  "\n's to the end' sums the stages' times over every step (no output written).\n\n");
         }
         // Static mesh objects (scenes/dam_break_cylinder.json): the default scene with a cylinder
-        // 0.2 m across standing in the surge's path, 0.5 m past the column. Whole runs with and without the object's correction (its distance grid dropped
-        // from the same setup), counting after every step the fluid inside the cylinder by that
-        // grid's signed distance.
+        // 0.2 m across standing in the surge's path, 0.5 m past the column. Whole runs with and
+        // without the object's correction (its distance grid dropped from the same setup),
+        // counting after every step the fluid inside the cylinder by that grid's signed distance.
         if (o.wants("objects")) {
             const double end_time = o.quick ? 0.6 : 1.0;
-            struct StepCase {
-                const char* cfl_number;
-                const char* largest;
-            };
             std::vector<WholeRun> runs;
             for (const StepCase c : {StepCase{"0.4", "0.0015"}, StepCase{"1", "0.03"}}) {
-                const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/dam_break_cylinder.json",
-                                               {std::string("solver.cfl_number=") + c.cfl_number,
-                                                std::string("solver.dt=") + c.largest});
-                const SimulationSetup with = build_setup(scene);
+                const SimulationSetup with = build_setup(scene_at_step("dam_break_cylinder.json", c));
                 const ContactField field = with.params.static_objects.at(0);
-                const std::vector<Real> distances = with.params.static_object_distances;
+                const std::vector<Real>& distances = with.params.static_object_distances;
                 HostParticles particles;
                 const StepObserver count_inside = [&](Simulation& sim, WholeRun& r) {
                     sim.download(particles);
@@ -482,9 +480,8 @@ int main(int argc, char** argv) {
                 SimulationSetup without = with;
                 without.params.static_objects.clear();
                 without.params.static_object_distances.clear();
-                const std::string step = std::string("CFL ") + c.cfl_number + ", largest step " + c.largest + " s";
-                runs.push_back(run_whole(o, step + ", object's correction on", with, end_time, count_inside));
-                runs.push_back(run_whole(o, step + ", object's correction off", without, end_time, count_inside));
+                runs.push_back(run_whole(o, c.name() + ", object's correction on", with, end_time, count_inside));
+                runs.push_back(run_whole(o, c.name() + ", object's correction off", without, end_time, count_inside));
             }
             std::ostringstream t;
             t << "### Static mesh objects (scenes/dam_break_cylinder.json: the default dam break and a static cylinder, r 0.1 m, at x = 1.1 m; to t = "

@@ -65,14 +65,11 @@ constexpr double kMaxRayStart = 1e6;
 class EmbreeScene {
 public:
     explicit EmbreeScene(const TriangleMesh& mesh) : embree_(mesh, collect_all_hits) {
-        reach_ = embree_.reach();
-        unit_ = embree_.unit();
-        center_ = embree_.center();
         normals_.resize(mesh.triangles.size());
         for (std::size_t t = 0; t < mesh.triangles.size(); ++t) normals_[t] = triangle_normal(mesh, t);
     }
 
-    double reach() const { return reach_; }
+    double reach() const { return embree_.reach(); }
 
     // Casts the infinite line through `through` along unit `dir`, starting `back` before it, and
     // returns its surface crossings (t measured from the start) with merged duplicate hits.
@@ -80,11 +77,14 @@ public:
                    std::vector<Crossing>& out) const {
         hits.clear();
         out.clear();
-        const Vec3d org = (through - center_ - back * dir) / unit_;
-        if (!org.allFinite() || org.cwiseAbs().maxCoeff() > kMaxRayStart * reach_ / unit_) {
+        const double reach = embree_.reach(), unit = embree_.unit();
+        // The same operations, in the same order, as before EmbreeMesh was split out: a ray
+        // origin rounded otherwise could change a crossing at a vertex.
+        const Vec3d org = (through - embree_.center() - back * dir) / unit;
+        if (!org.allFinite() || org.cwiseAbs().maxCoeff() > kMaxRayStart * reach / unit) {
             std::ostringstream s;
-            s << "inside/outside test: a ray would start " << (through - center_).norm() + back
-              << " from the centre of a mesh of size " << reach_ << ", beyond what the single-precision ray tracer handles";
+            s << "inside/outside test: a ray would start " << (through - embree_.center()).norm() + back
+              << " from the centre of a mesh of size " << reach << ", beyond what the single-precision ray tracer handles";
             throw InputError(s.str());
         }
         RTCRayHit rh;
@@ -118,8 +118,8 @@ public:
         std::sort(hits.begin(), hits.end(), [](const RawHit& a, const RawHit& b) {
             return a.t < b.t || (a.t == b.t && a.prim < b.prim);
         });
-        const double eps = 1e-6 * reach_;
-        auto distance = [&](std::size_t k) { return double(hits[k].t) * unit_; };
+        const double eps = 1e-6 * reach;
+        auto distance = [&](std::size_t k) { return double(hits[k].t) * unit; };
         auto sign_of = [&](std::size_t k) {
             const double c = normals_[hits[k].prim].dot(dir);
             return c > 0 ? 1 : (c < 0 ? -1 : 0);
@@ -146,10 +146,7 @@ public:
 
 private:
     EmbreeMesh embree_;
-    Vec3d center_;
     std::vector<Vec3d> normals_;
-    double reach_ = 1;  // bounding-box diagonal
-    double unit_ = 1;   // the power of two Embree's coordinates are measured in
 };
 
 // Lattice line directions: axes, body diagonals, face diagonals (one per opposite pair).

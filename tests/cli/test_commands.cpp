@@ -311,6 +311,12 @@ TEST_CASE("info: the velocity-position correction, on in the default scene, name
     const Result off = run("info --set boundary.correction=false");
     REQUIRE(off.code == 0);
     CHECK(contains(off.out, "velocity-position correction off"));
+    // Off with a static object as the only boundary: still said.
+    const Result object_only = run("info --set boundary.walls=false --set boundary.correction=false --set "
+                                   "'objects=[{\"mesh\":{\"procedural\":\"sphere:radius=0.1\"},"
+                                   "\"transform\":{\"translation\":[1.2,0.3,0.4]},\"kind\":\"static\"}]'");
+    REQUIRE(object_only.code == 0);
+    CHECK(contains(object_only.out, "velocity-position correction off"));
     const Result open = run("info --set boundary.walls=false");
     REQUIRE(open.code == 0);
     CHECK(!contains(open.out, "velocity-position correction"));  // nothing to correct against
