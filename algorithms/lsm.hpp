@@ -19,9 +19,11 @@
 MW_BACKEND_BEGIN
 
 // Sums over members of one region, relative to its anchor (see the top of the file): su = Σ m̃ (u
-// - u_a), Au = Σ m̃ (u - u_a) qᵀ and, for damped objects, sv = Σ m̃ v and sl = Σ m̃ (x - c0) × v.
+// - u_a), Au = Σ m̃ (u - u_a) qᵀ; for damped objects sv = Σ m̃ v and sl = Σ m̃ (x - c0) × v; for
+// objects whose forces act through the regions, sf = Σ f̃ and sτ = Σ (x - c0) × f̃, with f̃ = f / (the
+// IBP's number of regions).
 struct RegionSums {
-    Vec3 su, sv, sl;
+    Vec3 su, sv, sl, sf, st;
     Mat3 Au;
 };
 
@@ -63,6 +65,10 @@ struct LsmData {
     Vec3* mean_displacement = nullptr;
     Vec3* region_velocity = nullptr;  // only written for objects with damping
     Vec3* region_omega = nullptr;
+    // Only written for objects with region_forces: each region's acceleration under its IBPs'
+    // (split) forces, linear, and angular about its centre of mass c0 + ū.
+    Vec3* region_acceleration = nullptr;
+    Vec3* region_angular_acceleration = nullptr;
     const LsmObjectParams* objects = nullptr;
 };
 
@@ -79,8 +85,8 @@ MW_INLINE Vec3 region_anchor_displacement(const LsmData& d, std::uint32_t r) {
 }
 
 MW_INLINE RegionSums sum_region_members(const LsmData& d, std::uint32_t begin, std::uint32_t end, Vec3 c0, Vec3 ua,
-                                        bool damp) {
-    RegionSums S{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, mat3_zero()};
+                                        bool damp, bool forces) {
+    RegionSums S{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, mat3_zero()};
     for (std::uint32_t k = begin; k < end; ++k) {
         const std::uint32_t s = d.member_index[k];
         const Real m = d.split_mass[s];
@@ -97,12 +103,21 @@ MW_INLINE RegionSums sum_region_members(const LsmData& d, std::uint32_t begin, s
             S.sv += mv;
             S.sl += cross(d.position[i] - c0, mv);
         }
+        if (forces) {
+            // Each IBP's force is split among its regions, as its mass is.
+            const Vec3 f = d.force[s] / Real(d.regions_end[s] - d.regions_begin[s]);
+            S.sf += f;
+            S.st += cross(d.position[d.store_of_slot[s]] - c0, f);
+        }
     }
     return S;
 }
 
 MW_INLINE bool region_damped(const LsmData& d, std::uint32_t r) {
     return d.objects[d.region_object[r]].damping_rate > Real(0);
+}
+MW_INLINE bool region_has_forces(const LsmData& d, std::uint32_t r) {
+    return d.objects[d.region_object[r]].region_forces != 0;
 }
 
 // Region sums, rotation (warm-started polar decomposition) and, for damped objects, the region's
@@ -118,7 +133,8 @@ inline void lsm_region_update(const LsmData d) {
         const std::uint32_t r = d.chunk_region[c];
         const std::uint32_t end = c + 1 < d.region_chunks[r + 1] ? d.chunk_begin[c + 1] : d.region_offsets[r + 1];
         d.chunk_sums[c] = sum_region_members(d, d.chunk_begin[c], end, d.region_c0[r],
-                                             region_anchor_displacement(d, r), region_damped(d, r));
+                                             region_anchor_displacement(d, r), region_damped(d, r),
+                                             region_has_forces(d, r));
     });
     parallel_for("lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
         const std::uint32_t begin = d.region_offsets[r], end = d.region_offsets[r + 1];
@@ -126,17 +142,18 @@ inline void lsm_region_update(const LsmData d) {
         const Real M = d.region_mass[r];
         const Vec3 c0 = d.region_c0[r];
         const bool damp = region_damped(d, std::uint32_t(r));
+        const bool forces = region_has_forces(d, std::uint32_t(r));
         const Vec3 ua = region_anchor_displacement(d, std::uint32_t(r));
         const std::uint32_t chunks_begin = d.chunk_count ? d.region_chunks[r] : 0u;
         const std::uint32_t chunks_end = d.chunk_count ? d.region_chunks[r + 1] : 0u;
         RegionSums S;
         if (chunks_begin == chunks_end) {
-            S = sum_region_members(d, begin, end, c0, ua, damp);
+            S = sum_region_members(d, begin, end, c0, ua, damp, forces);
         } else {
             S = d.chunk_sums[chunks_begin];
             for (std::uint32_t c = chunks_begin + 1; c < chunks_end; ++c) {
                 const RegionSums& part = d.chunk_sums[c];
-                S.su += part.su, S.sv += part.sv, S.sl += part.sl;
+                S.su += part.su, S.sv += part.sv, S.sl += part.sl, S.sf += part.sf, S.st += part.st;
                 S.Au = S.Au + part.Au;
             }
         }
@@ -154,6 +171,16 @@ inline void lsm_region_update(const LsmData d) {
             const Quat Rinv{R.w, -R.x, -R.y, -R.z};
             d.region_velocity[r] = S.sv / M;
             d.region_omega[r] = quat_rotate(R, d.region_inertia_inv[r] * quat_rotate(Rinv, L));
+        }
+        if (forces) {
+            // Newton and Euler for the region as a rigid body (the gyroscopic term ω × Iω is left
+            // to the shape matching, which carries the rotation): a = F/M, dω/dt = I⁻¹ τ about
+            // c = c0 + ū. Summed over every IBP's mean of its regions, m (a + dω/dt × (x - c)) gives
+            // back the total force and torque: momentum and angular momentum are kept.
+            const Vec3 torque = S.st - cross(ubar, S.sf);
+            const Quat Rinv{R.w, -R.x, -R.y, -R.z};
+            d.region_acceleration[r] = S.sf / M;
+            d.region_angular_acceleration[r] = quat_rotate(R, d.region_inertia_inv[r] * quat_rotate(Rinv, torque));
         }
     });
 }
@@ -209,7 +236,19 @@ inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
             // v <- v_rigid + e^(-k Δt) (v - v_rigid)
             v += (Real(1) - std::exp(-obj.damping_rate * p.dt)) * rigid_offset;
         }
-        v += (obj.alpha / p.dt) * offset + p.dt * (d.force[s] / d.mass[s] + p.gravity);
+        Vec3 external = d.force[s] / d.mass[s];
+        if (obj.region_forces) {
+            // The mean over i's regions of each region's rigid acceleration at x.
+            Vec3 sum{0, 0, 0};
+            const std::uint32_t begin = d.regions_begin[s], end = d.regions_end[s];
+            for (std::uint32_t k = begin; k < end; ++k) {
+                const std::uint32_t r = d.member_index[k];
+                sum += d.region_acceleration[r] +
+                       cross(d.region_angular_acceleration[r], x - (d.region_c0[r] + d.mean_displacement[r]));
+            }
+            external = sum / Real(end - begin);
+        }
+        v += (obj.alpha / p.dt) * offset + p.dt * (external + p.gravity);
         x += p.dt * v;
         // Domain walls: clamp into the box shrunk by the margin, drop the outward normal velocity,
         // scale the tangential velocity by (1 - friction) on each wall touched.

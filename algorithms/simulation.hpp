@@ -71,6 +71,11 @@ struct SimulationParams {
     // values stored one object after another in static_object_distances (ContactField::field.first).
     std::vector<ContactField> static_objects;
     std::vector<Real> static_object_distances;
+    // Two-way coupling (algorithms/coupling.hpp): the forces the fluid feels from a moving solid's
+    // boundary particles act back on the solid. Without it solids push the fluid but feel none of
+    // it (one-way, as before the eighteenth session). The scenes' coupling.two_way turns it on by
+    // default; in code it stays off, so that tests and benchmarks built in code state it.
+    bool two_way_coupling = false;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;
@@ -179,6 +184,10 @@ class Simulation {
     virtual double time() const = 0;
     virtual std::string backend_name() const = 0;
     virtual std::string device_name() const = 0;
+    // The force the fluid exerted on each solid object in the last step, N, indexed like
+    // SimulationSetup::solids (0 for static objects, and without two-way coupling). A copy to the
+    // host, for tests and reports.
+    virtual std::vector<std::array<double, 3>> fluid_force_on_solids() const = 0;
 };
 
 }  // namespace mw

@@ -7,9 +7,12 @@
 // each sort one kernel rebuilds store_of_slot[slot] = store index. All LSM arrays are indexed by
 // slot; kernels read and write positions and velocities in the store through that map.
 #pragma once
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "algorithms/coupling.hpp"
 #include "algorithms/lsm.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
@@ -99,6 +102,12 @@ class SolidBodies {
             region_velocity_.assign(regions, Vec3{0, 0, 0});
             region_omega_.assign(regions, Vec3{0, 0, 0});
         }
+        bool any_region_forces = false;
+        for (const auto& o : L.objects) any_region_forces = any_region_forces || o.region_forces;
+        if (any_region_forces) {
+            region_acceleration_.assign(regions, Vec3{0, 0, 0});
+            region_angular_acceleration_.assign(regions, Vec3{0, 0, 0});
+        }
         objects_.upload(L.objects);
         gp_rest_.upload(L.gp_rest);
         gp_offsets_.upload(L.gp_offsets);
@@ -107,9 +116,21 @@ class SolidBodies {
         sbp_.upload(L.sbp);
         sbp_normal_.upload(L.sbp_normal);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
+        object_count_ = setup.solids.size();
+        // Two-way coupling: only where fluid can push (a solids-only scene has none to gather).
+        const bool any_fluid = std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end();
+        if (setup.params.two_way_coupling && any_fluid) {
+            const SurfaceShares shares = surface_shares(L);
+            share_offsets_.upload(shares.offsets);
+            share_sbp_.upload(shares.sbp);
+            share_weight_.upload(shares.weight);
+            reaction_.assign(ibp_count_ + sbp_count_, Vec3{0, 0, 0});
+        }
     }
 
     bool active() const { return ibp_count_ > 0; }
+    // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.
+    bool coupled() const { return !share_offsets_.empty(); }
     std::size_t ibp_count() const { return ibp_count_; }
     std::size_t region_member_count() const { return members_total_; }
     std::size_t region_chunk_count() const { return chunk_begin_.size(); }
@@ -157,6 +178,37 @@ class SolidBodies {
     }
 
     View<Vec3> force() { return force_.view(); }
+
+    // The coupling's arrays (coupled() only); the slot map must be current.
+    CouplingData coupling() {
+        CouplingData c;
+        c.store_of_slot = store_of_slot_.view().data();
+        c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
+        c.sbp_count = static_cast<std::uint32_t>(sbp_count_);
+        c.reaction = reaction_.view().data();
+        c.force = force_.view().data();
+        c.share_offsets = share_offsets_.view().data();
+        c.share_sbp = share_sbp_.view().data();
+        c.share_weight = share_weight_.view().data();
+        return c;
+    }
+
+    // The force on each object's IBPs in the last step (N, summed in double on the host),
+    // indexed like SimulationSetup::solids; static objects and uncoupled runs give 0. A copy to
+    // the host: for tests and reports, not for the step.
+    std::vector<std::array<double, 3>> object_forces() const {
+        std::vector<std::array<double, 3>> total(object_count_, std::array<double, 3>{0, 0, 0});
+        if (ibp_count_ == 0) return total;
+        const std::vector<Vec3> f = force_.to_host();
+        const std::vector<std::int32_t> object = object_.to_host();
+        for (std::size_t s = 0; s < f.size(); ++s) {
+            std::array<double, 3>& t = total[std::size_t(object[s])];
+            t[0] += f[s].x;
+            t[1] += f[s].y;
+            t[2] += f[s].z;
+        }
+        return total;
+    }
     View<const Vec3> sbp_normals() const { return sbp_normal_.cview(); }
 
     std::size_t bytes() const {
@@ -167,8 +219,10 @@ class SolidBodies {
                region_chunks_.bytes() + chunk_begin_.bytes() + chunk_region_.bytes() +
                chunk_sums_.bytes() +
                rotation_.bytes() + rotation_matrix_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
+               region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
-               sbp_.bytes() + sbp_normal_.bytes();
+               sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
+               share_weight_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -205,6 +259,8 @@ class SolidBodies {
         d.mean_displacement = mean_displacement_.view().data();
         d.region_velocity = region_velocity_.view().data();
         d.region_omega = region_omega_.view().data();
+        d.region_acceleration = region_acceleration_.view().data();
+        d.region_angular_acceleration = region_angular_acceleration_.view().data();
         d.objects = objects_.view().data();
         return d;
     }
@@ -230,7 +286,7 @@ class SolidBodies {
     }
 
    private:
-    std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0;
+    std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0, object_count_ = 0;
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;
     DeviceArray<Vec3> rest_;
@@ -251,12 +307,19 @@ class SolidBodies {
     DeviceArray<Quat> rotation_;
     DeviceArray<Mat3> rotation_matrix_;
     DeviceArray<Vec3> mean_displacement_, region_velocity_, region_omega_;
+    DeviceArray<Vec3> region_acceleration_, region_angular_acceleration_;  // rigid objects under coupling
     DeviceArray<LsmObjectParams> objects_;
     DeviceArray<Vec3> gp_rest_;
     DeviceArray<std::uint32_t> gp_offsets_, gp_links_;
     DeviceArray<Real> gp_weights_;
     DeviceArray<SbpLink> sbp_;
     DeviceArray<Vec3> sbp_normal_;
+    // Two-way coupling (coupling.hpp): this step's reaction per IBP and SBP slot, and the SBPs'
+    // shares of each IBP.
+    DeviceArray<Vec3> reaction_;
+
+    DeviceArray<std::uint32_t> share_offsets_, share_sbp_;
+    DeviceArray<Real> share_weight_;
 };
 
 MW_BACKEND_END

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "algorithms/coupling.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/neighbor_list.hpp"
 #include "algorithms/particle_store.hpp"
@@ -100,7 +101,22 @@ class BackendSimulation final : public Simulation {
             step_size_.after_step(retries, outcome == PcisphOutcome::kConverged, dt);
         }
 
-        // 5. Coupling forces on solids go here (they fill solids_.force()).
+        // 5. Two-way coupling: the reaction of every force the fluid felt from a moving solid's
+        //    boundary particles, onto the solid's IBPs (coupling.hpp).
+        if (has_coupling_) {
+            timers_.start(kCoupling);
+            const CouplingData coupling = solids_.coupling();
+            FluidPairs pairs;
+            pairs.grid = grid;
+            pairs.fluid_end = ranges_.fluid_end;
+            pairs.solid_end = ranges_.solid_end;
+            pairs.list_radius2 = use_lists_ ? fluid_.kernel.h * fluid_.kernel.h : Real(0);
+            fluid_reaction_on_solids(pairs, coupling, store_.position.cview(), store_.velocity.cview(),
+                                     predicted_.cview(), boundary_volume_.cview(), pressure_term_.cview(), fluid_,
+                                     has_viscosity_ && fluid_.wall_viscosity > Real(0));
+            gather_solid_forces(coupling);
+            timers_.stop(kCoupling);
+        }
         // 6. Solids: LSM of the IBPs (forces, gravity, domain walls), then GPs (Eq. 19) and SBPs.
         SolidSummary solid_motion;
         if (solids_.active()) {
@@ -155,6 +171,7 @@ class BackendSimulation final : public Simulation {
     double time() const override { return time_; }
     std::string backend_name() const override { return kBackendName; }
     std::string device_name() const override { return device_description(); }
+    std::vector<std::array<double, 3>> fluid_force_on_solids() const override { return solids_.object_forces(); }
 
    private:
     // The PCISPH loop over a neighbourhood (the grid, or this step's lists): predict, density and
@@ -213,9 +230,9 @@ class BackendSimulation final : public Simulation {
         return error;
     }
 
-    enum Stage { kNeighbors, kSolidVolumes, kViscosity, kPcisph, kLsm, kIntegrate, kStageCount };
-    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "solid_volumes", "viscosity",
-                                                             "pcisph",    "lsm",           "integrate"};
+    enum Stage { kNeighbors, kSolidVolumes, kViscosity, kPcisph, kCoupling, kLsm, kIntegrate, kStageCount };
+    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "solid_volumes", "viscosity", "pcisph",
+                                                             "coupling",  "lsm",           "integrate"};
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
@@ -278,6 +295,7 @@ class BackendSimulation final : public Simulation {
     bool has_viscosity_ = false;
     bool has_fluid_ = false;
     bool has_solid_volumes_ = false;  // moving solids and fluid: boundary volumes every step
+    bool has_coupling_ = false;       // ... and two-way coupling: the fluid's forces act on them
     SolidBodies solids_;
     ParticleCounts counts_;
     long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
@@ -392,6 +410,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     }
     has_viscosity_ = has_fluid_ && (fp.viscosity > 0 || (fp.wall_viscosity > 0 && store_.static_count() > 0));
     has_solid_volumes_ = solids_.active() && has_fluid_;
+    has_coupling_ = has_solid_volumes_ && solids_.coupled();
 
     // Boundary volumes only matter to fluid next to boundary particles: without fluid, or without
     // any boundary particle, they are neither stored nor computed. They are indexed like the store
@@ -411,6 +430,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (has_solid_volumes_) active_stages_.push_back(kSolidVolumes);
     if (has_viscosity_) active_stages_.push_back(kViscosity);
     if (has_fluid_) active_stages_.push_back(kPcisph);
+    if (has_coupling_) active_stages_.push_back(kCoupling);
     if (solids_.active()) active_stages_.push_back(kLsm);
     if (has_fluid_) active_stages_.push_back(kIntegrate);
 

@@ -151,6 +151,19 @@ int command_info(int argc, char** argv) {
         std::printf("            velocity-position correction off (boundary.correction false): only the Akinci "
                     "layers hold the fluid in\n");
     }
+    // Two-way coupling: whether the moving objects feel the fluid (docs/coupling.md).
+    const long moving_objects = std::count_if(scene.objects.begin(), scene.objects.end(),
+                                              [](const SceneObject& o) { return o.kind != SolidKind::kStatic; });
+    if (moving_objects && !scene.fluid_blocks.empty()) {
+        if (scene.params.two_way_coupling)
+            std::printf("coupling    two-way (coupling.two_way): the fluid's pressure%s acts back on %ld moving "
+                        "object(s), through their LSM regions; no velocity-position correction against them yet\n",
+                        f.wall_viscosity > 0 ? " and friction" : "", moving_objects);
+        else
+            std::printf("coupling    one-way (coupling.two_way false): %ld moving object(s) push the fluid and "
+                        "feel none of it\n",
+                        moving_objects);
+    }
     if (const std::string warning = scene.kernel_warning(); !warning.empty())
         std::printf("warning     %s\n", warning.c_str());
     return 0;

@@ -401,6 +401,12 @@ void read_boundary(Section s, Scene& scene) {
     s.finish();
 }
 
+// How fluid and moving solids act on each other (docs/scenes.md, "coupling").
+void read_coupling(Section s, Scene& scene) {
+    scene.params.two_way_coupling = s.boolean("two_way", true);
+    s.finish();
+}
+
 void read_neighbors(Section s, Scene& scene) {
     scene.params.ordering =
         s.choice("ordering", "zorder", {"zorder", "linear"}) == "linear" ? CellOrdering::kLinear : CellOrdering::kZOrder;
@@ -746,6 +752,7 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_fluid(root.object("fluid"), scene);
     read_solver(root.object("solver"), scene);
     read_boundary(root.object("boundary"), scene);
+    read_coupling(root.object("coupling"), scene);
     read_neighbors(root.object("neighbors"), scene);
     read_fluid_blocks(root, scene);
     read_static_boxes(root, scene);

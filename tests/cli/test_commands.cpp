@@ -809,3 +809,46 @@ TEST_CASE("guards: a run that loses more fluid through its walls than boundary.m
         CHECK(contains(r.err, "boundary.max_lost_fraction"));
     }
 }
+
+TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, on by default, off on request") {
+    const std::string scene = scene_file(
+        "coupled.json",
+        tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
+                                          "transform": {"translation": [0.15, 0.1, 0.1]}, "kind": "rigid", "density": 500}])"));
+    const auto stages_of = [](const Result& r) {
+        const auto j = nlohmann::json::parse(r.out);
+        std::vector<std::string> names;
+        for (const auto& s : j["stages"]) names.push_back(s.get<std::string>());
+        return names;
+    };
+    const Result on = run("info " + scene + " --json");
+    CAPTURE(on.err);
+    REQUIRE(on.code == 0);
+    const std::vector<std::string> with = stages_of(on);
+    // In the method's order: after PCISPH, before the solids' step.
+    const auto pcisph = std::find(with.begin(), with.end(), "pcisph"), coupling = std::find(with.begin(), with.end(), "coupling"),
+               lsm = std::find(with.begin(), with.end(), "lsm");
+    REQUIRE(coupling != with.end());
+    CHECK(pcisph < coupling);
+    CHECK(coupling < lsm);
+    CHECK(nlohmann::json::parse(on.out)["scene"]["coupling"]["two_way"] == true);
+    CHECK(contains(run("info " + scene).out, "two-way (coupling.two_way)"));
+    CHECK(contains(run("info " + scene + " --set coupling.two_way=false").out, "one-way (coupling.two_way false)"));
+
+    const Result off = run("info " + scene + " --json --set coupling.two_way=false");
+    REQUIRE(off.code == 0);
+    const std::vector<std::string> without = stages_of(off);
+    CHECK(std::find(without.begin(), without.end(), "coupling") == without.end());
+    CHECK(nlohmann::json::parse(off.out)["device_bytes"].get<long>() <
+          nlohmann::json::parse(on.out)["device_bytes"].get<long>());
+
+    // No fluid, nothing to couple: the stage is not run.
+    const Result dry = run("info " + scene + " --json --set fluid_blocks=[]");
+    REQUIRE(dry.code == 0);
+    const std::vector<std::string> solids_only = stages_of(dry);
+    CHECK(std::find(solids_only.begin(), solids_only.end(), "coupling") == solids_only.end());
+
+    const Result bad = run("info " + scene + " --set coupling.two_ways=true");
+    CHECK(bad.code != 0);
+    CHECK(contains(bad.err, "coupling.two_ways"));
+}

@@ -143,7 +143,7 @@ TEST_CASE("a water column on a pinned elastic slab: grid gathers follow neighbou
 
 namespace {
 // An elastic cube (0.12 m, w = 2) thrown down at 1 m/s into a pool 0.2 m deep in a 0.4 m square
-// tank at r0 = 0.02 m. Coupling forces are not built yet, so the cube falls through the water
+// tank at r0 = 0.02 m. One-way (two_way_coupling is off in code): the cube falls through the water
 // unhindered and pushes it aside as a moving boundary: the fluid sees boundary volumes that change
 // every step, and the cube's GPs and SBPs follow its IBPs.
 SimulationSetup cube_into_pool(SimulationParams::Lists lists) {
