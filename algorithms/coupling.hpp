@@ -25,7 +25,7 @@
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/pcisph.hpp"
 
-MW_BACKEND_BEGIN
+namespace mw {
 
 // Host, once: the SBP -> IBP shares in compressed rows by IBP slot (offsets[ibp_count + 1]),
 // each row ordered by SBP, so that the per-IBP sum has one fixed order.
@@ -69,6 +69,10 @@ inline SurfaceShares surface_shares(const LsmHostLayout& L) {
     }
     return out;
 }
+
+}  // namespace mw
+
+MW_BACKEND_BEGIN
 
 // What the two kernels read and write, by solid slot (solid_bodies.hpp: IBPs, then SBPs, then GPs).
 struct CouplingData {

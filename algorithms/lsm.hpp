@@ -42,7 +42,16 @@ struct LsmData {
     const std::uint8_t* pinned = nullptr;
     const std::uint32_t* regions_begin = nullptr;
     const std::uint32_t* regions_end = nullptr;
-    const Vec3* force = nullptr;  // external force per IBP (the coupling fills it)
+    // External forces (the two-way coupling's, per IBP), applied through the regions: with
+    // `forces`, each region moves as a rigid body under its members' forces (their total and
+    // torque; each IBP's force split among its regions, as its mass is), and an IBP takes the mean
+    // of its regions' accelerations at its position, not its own force over its own mass. A rigid
+    // object is then a rigid body under its forces, and momentum and angular momentum are kept.
+    // The coupling's forces land on the surface IBPs only; taken one IBP at a time they made a
+    // rigid box in a pool blow up within 15 steps and an elastic cube hit by fluid gain energy
+    // without bound (docs/coupling.md).
+    bool forces = false;
+    const Vec3* force = nullptr;
     Vec3* displacement = nullptr;  // u = x - x0 per IBP, this step's (the region sums read it)
     Mat3* mean_rotation = nullptr;  // average rotation of the IBP's regions (for Eq. 19)
     // Regions
@@ -65,8 +74,8 @@ struct LsmData {
     Vec3* mean_displacement = nullptr;
     Vec3* region_velocity = nullptr;  // only written for objects with damping
     Vec3* region_omega = nullptr;
-    // Only written for objects with region_forces: each region's acceleration under its IBPs'
-    // (split) forces, linear, and angular about its centre of mass c0 + ū.
+    // Only with `forces`: each region's acceleration under its IBPs' (split) forces, linear, and
+    // angular about its centre of mass c0 + ū.
     Vec3* region_acceleration = nullptr;
     Vec3* region_angular_acceleration = nullptr;
     const LsmObjectParams* objects = nullptr;
@@ -116,9 +125,6 @@ MW_INLINE RegionSums sum_region_members(const LsmData& d, std::uint32_t begin, s
 MW_INLINE bool region_damped(const LsmData& d, std::uint32_t r) {
     return d.objects[d.region_object[r]].damping_rate > Real(0);
 }
-MW_INLINE bool region_has_forces(const LsmData& d, std::uint32_t r) {
-    return d.objects[d.region_object[r]].region_forces != 0;
-}
 
 // Region sums, rotation (warm-started polar decomposition) and, for damped objects, the region's
 // rigid velocity (linear velocity V and angular velocity ω = I⁻¹ L, with the rest inertia
@@ -133,8 +139,7 @@ inline void lsm_region_update(const LsmData d) {
         const std::uint32_t r = d.chunk_region[c];
         const std::uint32_t end = c + 1 < d.region_chunks[r + 1] ? d.chunk_begin[c + 1] : d.region_offsets[r + 1];
         d.chunk_sums[c] = sum_region_members(d, d.chunk_begin[c], end, d.region_c0[r],
-                                             region_anchor_displacement(d, r), region_damped(d, r),
-                                             region_has_forces(d, r));
+                                             region_anchor_displacement(d, r), region_damped(d, r), d.forces);
     });
     parallel_for("lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
         const std::uint32_t begin = d.region_offsets[r], end = d.region_offsets[r + 1];
@@ -142,13 +147,12 @@ inline void lsm_region_update(const LsmData d) {
         const Real M = d.region_mass[r];
         const Vec3 c0 = d.region_c0[r];
         const bool damp = region_damped(d, std::uint32_t(r));
-        const bool forces = region_has_forces(d, std::uint32_t(r));
         const Vec3 ua = region_anchor_displacement(d, std::uint32_t(r));
         const std::uint32_t chunks_begin = d.chunk_count ? d.region_chunks[r] : 0u;
         const std::uint32_t chunks_end = d.chunk_count ? d.region_chunks[r + 1] : 0u;
         RegionSums S;
         if (chunks_begin == chunks_end) {
-            S = sum_region_members(d, begin, end, c0, ua, damp, forces);
+            S = sum_region_members(d, begin, end, c0, ua, damp, d.forces);
         } else {
             S = d.chunk_sums[chunks_begin];
             for (std::uint32_t c = chunks_begin + 1; c < chunks_end; ++c) {
@@ -172,7 +176,7 @@ inline void lsm_region_update(const LsmData d) {
             d.region_velocity[r] = S.sv / M;
             d.region_omega[r] = quat_rotate(R, d.region_inertia_inv[r] * quat_rotate(Rinv, L));
         }
-        if (forces) {
+        if (d.forces) {
             // Newton and Euler for the region as a rigid body (the gyroscopic term ω × Iω is left
             // to the shape matching, which carries the rotation): a = F/M, dω/dt = I⁻¹ τ about
             // c = c0 + ū. Summed over every IBP's mean of its regions, m (a + dω/dt × (x - c)) gives
@@ -186,16 +190,16 @@ inline void lsm_region_update(const LsmData d) {
 }
 
 // g_i - x_i for IBP slot s at position x with velocity v (see the top of the file); also the
-// mean rotation of its regions and, when `damp`, the mean over its regions of their rigid velocity
-// at x, minus v. Each region's term is formed as a difference before averaging: averaging large
+// mean rotation of its regions, when `damp` the mean over its regions of their rigid velocity at
+// x, minus v, and with d.forces the mean of their rigid acceleration at x (external forces). Each region's term is formed as a difference before averaging: averaging large
 // equal values (a translated body's ū) and subtracting afterwards rounds the same way for every
 // particle, which shows up as a slow spurious acceleration.
 MW_INLINE Vec3 lsm_goal_offset(const LsmData& d, std::uint32_t s, Vec3 x, Vec3 v, Mat3& mean_rotation, bool damp,
-                               Vec3& rigid_velocity_offset) {
+                               Vec3& rigid_velocity_offset, Vec3& external_acceleration) {
     const Vec3 x0 = d.rest[s];
     const Vec3 u = x - x0;
     const std::uint32_t begin = d.regions_begin[s], end = d.regions_end[s];
-    Vec3 sum{0, 0, 0}, vr{0, 0, 0};
+    Vec3 sum{0, 0, 0}, vr{0, 0, 0}, ar{0, 0, 0};
     Mat3 rsum = mat3_zero();
     for (std::uint32_t k = begin; k < end; ++k) {
         const std::uint32_t r = d.member_index[k];
@@ -206,14 +210,16 @@ MW_INLINE Vec3 lsm_goal_offset(const LsmData& d, std::uint32_t s, Vec3 x, Vec3 v
         sum += (R * q - q) + (ubar - u);
         rsum = rsum + R;
         if (damp) vr += (d.region_velocity[r] - v) + cross(d.region_omega[r], x - (c0 + ubar));
+        if (d.forces) ar += d.region_acceleration[r] + cross(d.region_angular_acceleration[r], x - (c0 + ubar));
     }
     const Real inv = end > begin ? Real(1) / Real(end - begin) : Real(0);
     mean_rotation = inv * rsum;
     rigid_velocity_offset = inv * vr;
+    external_acceleration = inv * ar;
     return inv * sum;
 }
 
-// The IBP update: v += α (g - x)/Δt + Δt (f/m + gravity) (after damping), x += Δt v, then the
+// The IBP update: v += α (g - x)/Δt + Δt (a_ext + gravity) (after damping), x += Δt v, then the
 // domain walls; pinned IBPs stay at their rest position with zero velocity.
 inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
     parallel_for("lsm_update", d.ibp_count, [=] MW_HD(std::size_t si) {
@@ -224,8 +230,8 @@ inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
         Vec3 v = d.velocity[i];
         const bool damp = obj.damping_rate > Real(0);
         Mat3 mean_rotation;
-        Vec3 rigid_offset;
-        const Vec3 offset = lsm_goal_offset(d, s, x, v, mean_rotation, damp, rigid_offset);
+        Vec3 rigid_offset, external;
+        const Vec3 offset = lsm_goal_offset(d, s, x, v, mean_rotation, damp, rigid_offset, external);
         d.mean_rotation[s] = mean_rotation;
         if (d.pinned[s]) {
             d.position[i] = d.rest[s];
@@ -235,18 +241,6 @@ inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
         if (damp) {
             // v <- v_rigid + e^(-k Δt) (v - v_rigid)
             v += (Real(1) - std::exp(-obj.damping_rate * p.dt)) * rigid_offset;
-        }
-        Vec3 external = d.force[s] / d.mass[s];
-        if (obj.region_forces) {
-            // The mean over i's regions of each region's rigid acceleration at x.
-            Vec3 sum{0, 0, 0};
-            const std::uint32_t begin = d.regions_begin[s], end = d.regions_end[s];
-            for (std::uint32_t k = begin; k < end; ++k) {
-                const std::uint32_t r = d.member_index[k];
-                sum += d.region_acceleration[r] +
-                       cross(d.region_angular_acceleration[r], x - (d.region_c0[r] + d.mean_displacement[r]));
-            }
-            external = sum / Real(end - begin);
         }
         v += (obj.alpha / p.dt) * offset + p.dt * (external + p.gravity);
         x += p.dt * v;
@@ -284,8 +278,8 @@ inline void lsm_goals(const LsmData d, View<Vec3> goal) {
         const std::uint32_t s = static_cast<std::uint32_t>(si);
         const Vec3 x = d.position[d.store_of_slot[s]];
         Mat3 mean_rotation;
-        Vec3 rigid_offset;
-        goal[s] = x + lsm_goal_offset(d, s, x, Vec3{0, 0, 0}, mean_rotation, false, rigid_offset);
+        Vec3 rigid_offset, external;
+        goal[s] = x + lsm_goal_offset(d, s, x, Vec3{0, 0, 0}, mean_rotation, false, rigid_offset, external);
     });
 }
 

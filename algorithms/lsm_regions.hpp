@@ -43,13 +43,6 @@ struct LsmObjectParams {
     Real damping_rate = 0;  // 1/s
     Real friction = 0;      // wall friction
     Real margin = 0;        // IBPs stay this far inside the domain walls
-    // External forces act through the regions (lsm.hpp): each region moves as a rigid body under
-    // its members' forces (their total and torque), and an IBP takes the mean of its regions'
-    // accelerations, not its own force over its own mass. A rigid object is then a rigid body
-    // under its forces. Set under two-way coupling, whose forces land on the surface IBPs only:
-    // taken one IBP at a time they made an elastic cube hit by fluid gain energy without bound,
-    // and a rigid box in a pool blow up in its first 15 steps (docs/coupling.md).
-    int region_forces = 0;
 };
 
 struct SbpLink {
@@ -222,9 +215,6 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         L.gp_count += s.gp.size();
     }
     L.objects.resize(setup.solids.size());
-    // Two-way coupling gives solids forces only where there is fluid to push them.
-    const bool coupled = setup.params.two_way_coupling &&
-                         std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end();
     L.region_offsets.assign(L.ibp_count + 1, 0);
     L.region_mass.assign(L.ibp_count, 0);
     L.region_c0.assign(L.ibp_count, Vec3{0, 0, 0});
@@ -257,7 +247,6 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         P.damping_rate = s.damping;
         P.friction = s.wall_friction;
         P.margin = Real(0.5) * s.spacing;
-        P.region_forces = coupled ? 1 : 0;
         const Real mass = s.density * s.spacing * s.spacing * s.spacing;
         const std::size_t base = ibp_base[o];
         for (std::size_t k = 0; k < s.ibp.size(); ++k) {

@@ -73,8 +73,8 @@ struct SimulationParams {
     std::vector<Real> static_object_distances;
     // Two-way coupling (algorithms/coupling.hpp): the forces the fluid feels from a moving solid's
     // boundary particles act back on the solid. Without it solids push the fluid but feel none of
-    // it (one-way, as before the eighteenth session). The scenes' coupling.two_way turns it on by
-    // default; in code it stays off, so that tests and benchmarks built in code state it.
+    // it (one-way, as before the eighteenth session). Off unless asked for, like the correction
+    // above (the scenes' coupling.two_way).
     bool two_way_coupling = false;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;

@@ -78,7 +78,6 @@ class SolidBodies {
         pinned_.upload(L.ibp_pinned);
         regions_begin_.upload(L.ibp_regions_begin);
         regions_end_.upload(L.ibp_regions_end);
-        force_.assign(ibp_count_, Vec3{0, 0, 0});
         displacement_.assign(ibp_count_, Vec3{0, 0, 0});
         mean_rotation_.assign(ibp_count_, mat3_identity());
         region_offsets_.upload(L.region_offsets);
@@ -102,12 +101,6 @@ class SolidBodies {
             region_velocity_.assign(regions, Vec3{0, 0, 0});
             region_omega_.assign(regions, Vec3{0, 0, 0});
         }
-        bool any_region_forces = false;
-        for (const auto& o : L.objects) any_region_forces = any_region_forces || o.region_forces;
-        if (any_region_forces) {
-            region_acceleration_.assign(regions, Vec3{0, 0, 0});
-            region_angular_acceleration_.assign(regions, Vec3{0, 0, 0});
-        }
         objects_.upload(L.objects);
         gp_rest_.upload(L.gp_rest);
         gp_offsets_.upload(L.gp_offsets);
@@ -117,7 +110,8 @@ class SolidBodies {
         sbp_normal_.upload(L.sbp_normal);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
-        // Two-way coupling: only where fluid can push (a solids-only scene has none to gather).
+        // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
+        // forces act through the regions (lsm.hpp, LsmData::forces).
         const bool any_fluid = std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end();
         if (setup.params.two_way_coupling && any_fluid) {
             const SurfaceShares shares = surface_shares(L);
@@ -125,12 +119,15 @@ class SolidBodies {
             share_sbp_.upload(shares.sbp);
             share_weight_.upload(shares.weight);
             reaction_.assign(ibp_count_ + sbp_count_, Vec3{0, 0, 0});
+            force_.assign(ibp_count_, Vec3{0, 0, 0});
+            region_acceleration_.assign(regions, Vec3{0, 0, 0});
+            region_angular_acceleration_.assign(regions, Vec3{0, 0, 0});
         }
     }
 
     bool active() const { return ibp_count_ > 0; }
     // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.
-    bool coupled() const { return !share_offsets_.empty(); }
+    bool coupled() const { return !force_.empty(); }
     std::size_t ibp_count() const { return ibp_count_; }
     std::size_t region_member_count() const { return members_total_; }
     std::size_t region_chunk_count() const { return chunk_begin_.size(); }
@@ -177,8 +174,6 @@ class SolidBodies {
         return i;
     }
 
-    View<Vec3> force() { return force_.view(); }
-
     // The coupling's arrays (coupled() only); the slot map must be current.
     CouplingData coupling() {
         CouplingData c;
@@ -198,7 +193,7 @@ class SolidBodies {
     // the host: for tests and reports, not for the step.
     std::vector<std::array<double, 3>> object_forces() const {
         std::vector<std::array<double, 3>> total(object_count_, std::array<double, 3>{0, 0, 0});
-        if (ibp_count_ == 0) return total;
+        if (!coupled()) return total;
         const std::vector<Vec3> f = force_.to_host();
         const std::vector<std::int32_t> object = object_.to_host();
         for (std::size_t s = 0; s < f.size(); ++s) {
@@ -238,6 +233,7 @@ class SolidBodies {
         d.pinned = pinned_.view().data();
         d.regions_begin = regions_begin_.view().data();
         d.regions_end = regions_end_.view().data();
+        d.forces = coupled();
         d.force = force_.view().data();
         d.displacement = displacement_.view().data();
         d.mean_rotation = mean_rotation_.view().data();
@@ -294,7 +290,7 @@ class SolidBodies {
     DeviceArray<std::int32_t> object_;
     DeviceArray<std::uint8_t> pinned_;
     DeviceArray<std::uint32_t> regions_begin_, regions_end_;
-    DeviceArray<Vec3> force_;
+    DeviceArray<Vec3> force_;  // per IBP, the coupling's (empty without it)
     DeviceArray<Vec3> displacement_;  // u = x - x0 per IBP, rewritten every LSM step
     DeviceArray<Mat3> mean_rotation_;
     DeviceArray<std::uint32_t> region_offsets_, member_index_;
@@ -307,7 +303,7 @@ class SolidBodies {
     DeviceArray<Quat> rotation_;
     DeviceArray<Mat3> rotation_matrix_;
     DeviceArray<Vec3> mean_displacement_, region_velocity_, region_omega_;
-    DeviceArray<Vec3> region_acceleration_, region_angular_acceleration_;  // rigid objects under coupling
+    DeviceArray<Vec3> region_acceleration_, region_angular_acceleration_;  // under coupling only
     DeviceArray<LsmObjectParams> objects_;
     DeviceArray<Vec3> gp_rest_;
     DeviceArray<std::uint32_t> gp_offsets_, gp_links_;
@@ -317,7 +313,6 @@ class SolidBodies {
     // Two-way coupling (coupling.hpp): this step's reaction per IBP and SBP slot, and the SBPs'
     // shares of each IBP.
     DeviceArray<Vec3> reaction_;
-
     DeviceArray<std::uint32_t> share_offsets_, share_sbp_;
     DeviceArray<Real> share_weight_;
 };

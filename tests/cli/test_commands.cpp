@@ -810,7 +810,7 @@ TEST_CASE("guards: a run that loses more fluid through its walls than boundary.m
     }
 }
 
-TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, on by default, off on request") {
+TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, when the scene asks for it") {
     const std::string scene = scene_file(
         "coupled.json",
         tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
@@ -821,7 +821,7 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
         for (const auto& s : j["stages"]) names.push_back(s.get<std::string>());
         return names;
     };
-    const Result on = run("info " + scene + " --json");
+    const Result on = run("info " + scene + " --json --set coupling.two_way=true");
     CAPTURE(on.err);
     REQUIRE(on.code == 0);
     const std::vector<std::string> with = stages_of(on);
@@ -832,18 +832,20 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
     CHECK(pcisph < coupling);
     CHECK(coupling < lsm);
     CHECK(nlohmann::json::parse(on.out)["scene"]["coupling"]["two_way"] == true);
-    CHECK(contains(run("info " + scene).out, "two-way (coupling.two_way)"));
-    CHECK(contains(run("info " + scene + " --set coupling.two_way=false").out, "one-way (coupling.two_way false)"));
+    CHECK(contains(run("info " + scene + " --set coupling.two_way=true").out, "two-way (coupling.two_way)"));
+    CHECK(contains(run("info " + scene).out, "one-way (coupling.two_way false)"));
 
-    const Result off = run("info " + scene + " --json --set coupling.two_way=false");
+    // Off by default, like every physics switch added after the first release.
+    const Result off = run("info " + scene + " --json");
     REQUIRE(off.code == 0);
+    CHECK(nlohmann::json::parse(off.out)["scene"]["coupling"]["two_way"] == false);
     const std::vector<std::string> without = stages_of(off);
     CHECK(std::find(without.begin(), without.end(), "coupling") == without.end());
     CHECK(nlohmann::json::parse(off.out)["device_bytes"].get<long>() <
           nlohmann::json::parse(on.out)["device_bytes"].get<long>());
 
     // No fluid, nothing to couple: the stage is not run.
-    const Result dry = run("info " + scene + " --json --set fluid_blocks=[]");
+    const Result dry = run("info " + scene + " --json --set fluid_blocks=[] --set coupling.two_way=true");
     REQUIRE(dry.code == 0);
     const std::vector<std::string> solids_only = stages_of(dry);
     CHECK(std::find(solids_only.begin(), solids_only.end(), "coupling") == solids_only.end());
@@ -851,4 +853,8 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
     const Result bad = run("info " + scene + " --set coupling.two_ways=true");
     CHECK(bad.code != 0);
     CHECK(contains(bad.err, "coupling.two_ways"));
+    const Result wrong_type = run("info " + scene + " --set coupling.two_way=1");
+    CHECK(wrong_type.code != 0);
+    CHECK(contains(wrong_type.err, "coupling.two_way"));
+    CHECK(contains(wrong_type.err, "true or false"));
 }
