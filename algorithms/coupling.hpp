@@ -7,7 +7,9 @@
 //      pressure (Akinci 2012; pcisph.hpp)  F_b = Σ_i m ψ_b (p_i/ρ_i²) ∇W(x*_i - x_b)
 //      friction (Eq. 8, when on)           F_b = -Σ_i m (μ_w/ρ0) V_b ∇²W(x_i - x_b) (v_b - v_i)
 //    with the last PCISPH iteration's predicted positions x* and pressures, so that the pair's
-//    two forces cancel to rounding: the fluid and the solids together conserve momentum.
+//    two forces cancel to rounding: the fluid and the solids together conserve momentum. With the
+//    velocity–position correction against solids on, an SBP's reaction also carries the impulse
+//    the correction gave it at the end of the last step (solid_contact.hpp), as J / Δt.
 // 2. Each IBP's force: its own reaction, plus a share of each SBP's. The shares are the transpose
 //    of the interpolation that moves the SBPs (an SBP follows its triangle's GPs by barycentric
 //    weights, a GP its linked IBPs by Eq. 19's normalised weights): an SBP's shares sum to 1, so
@@ -83,6 +85,10 @@ struct CouplingData {
     const std::uint32_t* share_offsets = nullptr;
     const std::uint32_t* share_sbp = nullptr;
     const Real* share_weight = nullptr;
+    // The impulses the velocity–position correction gave the SBPs in the last step (per SBP;
+    // null without it, solid_contact.hpp): they join this step's reaction as J / Δt.
+    const Vec3* sbp_contact_impulse = nullptr;
+    Real inverse_dt = 0;
 };
 
 // The pairs the fluid summed: in grid mode all in the 27 cells (the relation is symmetric:
@@ -119,7 +125,10 @@ void fluid_reaction_on_solids(const FluidPairs pairs, const CouplingData d, View
             if (friction) friction_sum += c.kernel.laplacian_visc_r2(norm2(xi - xb)) * (vb - velocity[i]);
         });
         const Real vb_volume = boundary_volume[b];
-        d.reaction[s] = (pressure_scale * vb_volume) * pressure_sum + (friction_scale * vb_volume) * friction_sum;
+        Vec3 reaction = (pressure_scale * vb_volume) * pressure_sum + (friction_scale * vb_volume) * friction_sum;
+        if (d.sbp_contact_impulse && s >= d.ibp_count)
+            reaction += d.inverse_dt * d.sbp_contact_impulse[s - d.ibp_count];
+        d.reaction[s] = reaction;
     });
 }
 

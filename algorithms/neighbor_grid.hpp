@@ -33,6 +33,16 @@ MW_INLINE std::uint32_t spread_bits_3(std::uint32_t v) {
     return v;
 }
 
+// The inverse of spread_bits_3: every third bit of v, from bit 0, packed into the low 10 bits.
+MW_INLINE std::uint32_t compact_bits_3(std::uint32_t v) {
+    v &= 0x09249249u;
+    v = (v | (v >> 2)) & 0x030c30c3u;
+    v = (v | (v >> 4)) & 0x0300f00fu;
+    v = (v | (v >> 8)) & 0x030000ffu;
+    v = (v | (v >> 16)) & 0x3ffu;
+    return v;
+}
+
 struct GridShape {
     Vec3 origin{0, 0, 0};
     Real inv_cell = 1;
@@ -57,6 +67,18 @@ struct GridShape {
         for (int a = 0; a < 3; ++a) {
             int v = f[a] >= Real(0) ? static_cast<int>(f[a]) : 0;
             c[a] = v < dims[a] ? v : dims[a] - 1;
+        }
+    }
+    // The cell coordinates a sort key (sort_key) was made from.
+    MW_INLINE void cell_of_key(std::uint32_t key, int c[3]) const {
+        if (zorder) {
+            const std::uint32_t code = key & ((std::uint32_t(1) << (3 * morton_bits)) - 1u);
+            for (int a = 0; a < 3; ++a) c[a] = static_cast<int>(compact_bits_3(code >> a));
+        } else {
+            const std::uint32_t cell = key % cell_count;
+            c[0] = static_cast<int>(cell % std::uint32_t(dims[0]));
+            c[1] = static_cast<int>((cell / std::uint32_t(dims[0])) % std::uint32_t(dims[1]));
+            c[2] = static_cast<int>(cell / (std::uint32_t(dims[0]) * std::uint32_t(dims[1])));
         }
     }
     MW_INLINE std::uint32_t linear(const int c[3]) const {
@@ -86,6 +108,7 @@ struct GridView {
     const std::uint32_t* static_begin = nullptr;  // [cell]; null when the scene has no static boundary
     const std::uint32_t* static_end = nullptr;
     bool has_solids = false;  // moving solid particles exist: otherwise their 27 cells are skipped
+    const std::uint32_t* sorted_key = nullptr;  // each moving particle's sort key at the last build
 
     // Calls f(j) for every particle j in the cells within one support radius of x's cell (27 cells
     // of size h, or 125 of size h/2), from the given cell ranges. The caller checks distances.
@@ -93,6 +116,12 @@ struct GridView {
     MW_INLINE void for_each_in_ranges(const std::uint32_t* first, const std::uint32_t* last, Vec3 x, F&& f) const {
         int c[3];
         shape.clamped_cell_of(x, c);
+        for_each_in_ranges_around(first, last, c, f);
+    }
+    // The same around cell c.
+    template <class F>
+    MW_INLINE void for_each_in_ranges_around(const std::uint32_t* first, const std::uint32_t* last, const int c[3],
+                                             F&& f) const {
         const int r = shape.reach;
         const int x0 = c[0] - r > 0 ? c[0] - r : 0;
         const int x1 = c[0] + r < shape.dims[0] ? c[0] + r : shape.dims[0] - 1;
@@ -131,6 +160,22 @@ struct GridView {
     template <class F>
     MW_INLINE void for_each_solid(Vec3 x, F&& f) const {
         if (has_solids) for_each_in_ranges(begin + shape.cell_count, end + shape.cell_count, x, f);
+    }
+    // Around the cell moving particle i was sorted into at this step's build (its position then),
+    // however far it has moved since: a pair of moving particles is then visited from either
+    // side or from neither (the velocity–position correction's two gathers, solid_contact.hpp).
+    template <class F>
+    MW_INLINE void for_each_fluid_around_particle(std::uint32_t i, F&& f) const {
+        int c[3];
+        shape.cell_of_key(sorted_key[i], c);
+        for_each_in_ranges_around(begin, end, c, f);
+    }
+    template <class F>
+    MW_INLINE void for_each_solid_around_particle(std::uint32_t i, F&& f) const {
+        if (!has_solids) return;
+        int c[3];
+        shape.cell_of_key(sorted_key[i], c);
+        for_each_in_ranges_around(begin + shape.cell_count, end + shape.cell_count, c, f);
     }
     template <class F>
     MW_INLINE void for_each_static(Vec3 x, F&& f) const {
@@ -211,6 +256,7 @@ class NeighborGrid {
         v.has_solids = has_solids_;
         v.begin = begin_.view().data();
         v.end = end_.view().data();
+        v.sorted_key = sorted_keys_.view().data();
         if (!static_begin_.empty()) {
             v.static_begin = static_begin_.view().data();
             v.static_end = static_end_.view().data();

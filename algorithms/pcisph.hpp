@@ -9,6 +9,7 @@
 #pragma once
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/sph_kernels.hpp"
+#include "algorithms/virtual_boundary.hpp"
 #include "algorithms/wall_contact.hpp"
 #include "algorithms/wall_mirror.hpp"
 
@@ -99,16 +100,20 @@ void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count
 }
 
 // x*_i = x_i + Δt v*_i with v*_i = v_i + Δt (a_np + a_p), then the position rule of the
-// velocity–position correction (wall_contact.hpp). Without a non-pressure field, a_np is gravity.
+// velocity–position correction: against moving solids' SBPs where it is on (virtual_boundary.hpp),
+// then against the walls (wall_contact.hpp). Without a non-pressure field, a_np is gravity.
 // A null pressure_acc means no pressure acceleration yet.
 inline void predict_positions(std::size_t fluid_count, View<const Vec3> position, View<const Vec3> velocity,
                               const Vec3* nonpressure, const Vec3* pressure_acc, View<Vec3> predicted, Vec3 gravity,
-                              Real dt, WallContact walls) {
+                              Real dt, WallContact walls, SolidSurface solids = SolidSurface{}) {
     parallel_for("pcisph_predict", fluid_count, [=] MW_HD(std::size_t i) {
         Vec3 a = nonpressure ? nonpressure[i] : gravity;
         if (pressure_acc) a += pressure_acc[i];
         const Vec3 v = velocity[i] + dt * a;
-        predicted[i] = walls.correct_predicted(position[i] + dt * v, v);
+        Vec3 x = position[i] + dt * v;
+        if (solids.active())
+            x = solids.correct_predicted(static_cast<std::uint32_t>(i), x, velocity[i], position, velocity);
+        predicted[i] = walls.correct_predicted(x, v);
     });
 }
 

@@ -76,6 +76,13 @@ struct SimulationParams {
     // it (one-way, as before the eighteenth session). Off unless asked for, like the correction
     // above (the scenes' coupling.two_way).
     bool two_way_coupling = false;
+    // The velocity–position correction against elastic and rigid objects' surface particles
+    // (algorithms/solid_contact.hpp): fluid moving into one is stopped 0.45 r0 from its SBPs and
+    // exchanges momentum with it (two-way), or takes its velocity (one-way). Off unless asked
+    // for (the scenes' coupling.correction). `solid_slip`: the tangential rule's ∂ (0 no-slip,
+    // 1 free slip).
+    bool solid_correction = false;
+    Real solid_slip = 1;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;
@@ -188,6 +195,10 @@ class Simulation {
     // SimulationSetup::solids (0 for static objects, and without two-way coupling). A copy to the
     // host, for tests and reports.
     virtual std::vector<std::array<double, 3>> fluid_force_on_solids() const = 0;
+    // The momentum the velocity–position correction gave each solid object at the end of the last
+    // step, kg m/s, which reaches its IBPs in the next step's coupling (algorithms/solid_contact.hpp);
+    // 0 without the correction or two-way coupling. A copy to the host, for tests.
+    virtual std::vector<std::array<double, 3>> pending_contact_impulse() const = 0;
 };
 
 }  // namespace mw

@@ -17,6 +17,7 @@
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
 #include "algorithms/pcisph.hpp"
+#include "algorithms/solid_contact.hpp"
 #include "algorithms/solid_interpolation.hpp"
 
 MW_BACKEND_BEGIN
@@ -122,6 +123,15 @@ class SolidBodies {
             force_.assign(ibp_count_, Vec3{0, 0, 0});
             region_acceleration_.assign(regions, Vec3{0, 0, 0});
             region_angular_acceleration_.assign(regions, Vec3{0, 0, 0});
+            // The velocity–position correction's side of it (solid_contact.hpp): the SBPs' contact
+            // masses, and the impulses they take, which wait for the next step's coupling.
+            if (setup.params.solid_correction) {
+                sbp_inverse_mass_.upload(sbp_inverse_contact_mass(L, shares));
+                sbp_impulse_.assign(sbp_count_, Vec3{0, 0, 0});
+                sbp_object_.resize(sbp_count_);
+                for (std::size_t k = 0; k < sbp_count_; ++k)
+                    sbp_object_[k] = setup.object[L.scene_index[ibp_count_ + k]];
+            }
         }
     }
 
@@ -185,8 +195,43 @@ class SolidBodies {
         c.share_offsets = share_offsets_.view().data();
         c.share_sbp = share_sbp_.view().data();
         c.share_weight = share_weight_.view().data();
+        if (!sbp_impulse_.empty()) c.sbp_contact_impulse = sbp_impulse_.view().data();
         return c;
     }
+
+    // The solids' surface for the velocity–position correction (virtual_boundary.hpp), over this
+    // step's grid.
+    SolidSurface surface(const ParticleStore& store, const GridView& grid, Real band, Real reach) const {
+        SolidSurface c;
+        c.grid = grid;
+        c.type = store.type.cview();
+        c.solid_slot = solid_slot_->cview();
+        c.sbp_normal = sbp_normal_.view().data();
+        c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
+        c.sbp_count = static_cast<std::uint32_t>(sbp_count_);
+        c.band = band;
+        c.reach = reach;
+        return c;
+    }
+    // The correction after the integration (solid_contact.hpp); the slot map must be current.
+    // With two-way coupling the SBPs have finite contact masses and take impulses
+    // (`impulse_per_weight`: per fluid particle, the caller's); one-way, none.
+    SolidContactData contact(const SolidSurface& surface, Real slip, Real fluid_mass, Vec3* impulse_per_weight) {
+        SolidContactData c;
+        c.surface = surface;
+        c.store_of_slot = store_of_slot_.view().data();
+        if (!sbp_impulse_.empty()) {
+            c.sbp_inverse_mass = sbp_inverse_mass_.view().data();
+            c.sbp_impulse = sbp_impulse_.view().data();
+            c.impulse_per_weight = impulse_per_weight;
+        }
+        c.slip = slip;
+        c.fluid_inverse_mass = Real(1) / fluid_mass;
+        return c;
+    }
+    // Whether the correction exchanges momentum with the solids (two-way coupling and the
+    // correction on).
+    bool contact_takes_impulses() const { return !sbp_impulse_.empty(); }
 
     // The force on each object's IBPs in the last step (N, summed in double on the host),
     // indexed like SimulationSetup::solids; static objects and uncoupled runs give 0. A copy to
@@ -204,6 +249,21 @@ class SolidBodies {
         }
         return total;
     }
+    // The impulse each object's SBPs took in the last step's velocity–position correction, which
+    // the next step's coupling applies (kg m/s, summed in double on the host; 0 without it). For
+    // tests: momentum is kept only counting it.
+    std::vector<std::array<double, 3>> object_contact_impulses() const {
+        std::vector<std::array<double, 3>> total(object_count_, std::array<double, 3>{0, 0, 0});
+        if (sbp_impulse_.empty()) return total;
+        const std::vector<Vec3> impulse = sbp_impulse_.to_host();
+        for (std::size_t k = 0; k < impulse.size(); ++k) {
+            std::array<double, 3>& t = total[std::size_t(sbp_object_[k])];
+            t[0] += impulse[k].x;
+            t[1] += impulse[k].y;
+            t[2] += impulse[k].z;
+        }
+        return total;
+    }
     View<const Vec3> sbp_normals() const { return sbp_normal_.cview(); }
 
     std::size_t bytes() const {
@@ -217,7 +277,7 @@ class SolidBodies {
                region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
-               share_weight_.bytes();
+               share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -315,6 +375,10 @@ class SolidBodies {
     DeviceArray<Vec3> reaction_;
     DeviceArray<std::uint32_t> share_offsets_, share_sbp_;
     DeviceArray<Real> share_weight_;
+    // The velocity–position correction under two-way coupling (solid_contact.hpp): per SBP.
+    DeviceArray<Real> sbp_inverse_mass_;
+    DeviceArray<Vec3> sbp_impulse_;
+    std::vector<std::int32_t> sbp_object_;  // host: each SBP's object, for object_contact_impulses()
 };
 
 MW_BACKEND_END

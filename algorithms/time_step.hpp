@@ -70,6 +70,10 @@ class BackendSimulation final : public Simulation {
             timers_.stop(kViscosity);
         }
         const Vec3* nonpressure = has_viscosity_ ? nonpressure_.view().data() : nullptr;
+        // The moving solids' surface for the velocity–position correction (its position rule in
+        // PCISPH, then the whole rule after the integration); none without it.
+        const SolidSurface solid_surface =
+            has_solid_contact_ ? solids_.surface(store_, grid, contact_band_, params_.fluid.spacing) : SolidSurface{};
 
         // 4. PCISPH: predict, density, pressure, pressure force, until the average density
         //    error is below η (at least min, at most max iterations).
@@ -87,9 +91,10 @@ class BackendSimulation final : public Simulation {
             for (;;) {
                 const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
                 int tried = 0;
-                error = use_lists_
-                            ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, delta, dt, tried, outcome)
-                            : pcisph_iterations(grid, fluid_count, nonpressure, delta, dt, tried, outcome);
+                error = use_lists_ ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, solid_surface, delta,
+                                                       dt, tried, outcome)
+                                   : pcisph_iterations(grid, fluid_count, nonpressure, solid_surface, delta, dt, tried,
+                                                       outcome);
                 iterations += tried;
                 if (outcome == PcisphOutcome::kConverged || !StepSizeControl::may_retry(params_.solver, retries, dt))
                     break;
@@ -105,12 +110,13 @@ class BackendSimulation final : public Simulation {
         //    boundary particles, onto the solid's IBPs (coupling.hpp).
         if (has_coupling_) {
             timers_.start(kCoupling);
-            const CouplingData coupling = solids_.coupling();
+            CouplingData coupling = solids_.coupling();
             FluidPairs pairs;
             pairs.grid = grid;
             pairs.fluid_end = ranges_.fluid_end;
             pairs.solid_end = ranges_.solid_end;
             pairs.list_radius2 = use_lists_ ? fluid_.kernel.h * fluid_.kernel.h : Real(0);
+            coupling.inverse_dt = Real(1) / dt;
             fluid_reaction_on_solids(pairs, coupling, store_.position.cview(), store_.velocity.cview(),
                                      predicted_.cview(), boundary_volume_.cview(), pressure_term_.cview(), fluid_,
                                      has_viscosity_ && fluid_.wall_viscosity > Real(0));
@@ -125,14 +131,40 @@ class BackendSimulation final : public Simulation {
             timers_.stop(kLsm);
         }
 
-        // 7. Integrate fluid (symplectic Euler); guard against NaN/inf; statistics.
+        // 7. Integrate fluid (symplectic Euler) with the walls' correction; guard against NaN/inf;
+        //    statistics (after the solids' correction where there is one: they describe the
+        //    fluid the step ends with).
         MotionSummary motion;
         if (has_fluid_) {
             timers_.start(kIntegrate);
             integrate_fluid(fluid_count, store_.position.view(), store_.velocity.view(), nonpressure,
                             pressure_acc_.cview(), fluid_.gravity, dt, wall_contact_);
-            motion = summarize_motion(fluid_count, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
+            if (!has_solid_contact_)
+                motion = summarize_motion(fluid_count, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
             timers_.stop(kIntegrate);
+        }
+        // 7b. The velocity–position correction against moving solids' SBPs (solid_contact.hpp).
+        //     Two-way, each SBP gathers its share of the momentum from the fluid's state before
+        //     the correction, so the corrected state goes to scratch first: the PCISPH loop's
+        //     predictions and pressure accelerations, free until the next step's loop.
+        if (has_solid_contact_) {
+            timers_.start(kSolidContact);
+            const SolidContactData contact =
+                solids_.contact(solid_surface, params_.solid_slip, fluid_.mass, impulse_per_weight_.view().data());
+            if (solids_.contact_takes_impulses()) {
+                View<Vec3> corrected_position = predicted_.view(), corrected_velocity = pressure_acc_.view();
+                correct_fluid_at_solids(fluid_count, store_.position.cview(), store_.velocity.cview(),
+                                        corrected_position, corrected_velocity, contact, wall_contact_);
+                gather_sbp_impulses(ranges_.fluid_end, ranges_.solid_end, store_.position.cview(),
+                                    store_.velocity.cview(), contact);
+                apply_fluid_correction(fluid_count, corrected_position, corrected_velocity, store_.position.view(),
+                                       store_.velocity.view());
+            } else {
+                correct_fluid_at_solids(fluid_count, store_.position.cview(), store_.velocity.cview(),
+                                        store_.position.view(), store_.velocity.view(), contact, wall_contact_);
+            }
+            motion = summarize_motion(fluid_count, store_.position.cview(), store_.velocity.cview(), fluid_.mass);
+            timers_.stop(kSolidContact);
         }
 
         time_ += dt;
@@ -166,12 +198,16 @@ class BackendSimulation final : public Simulation {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
                pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
                contact_boxes_.bytes() + contact_objects_.bytes() + contact_object_distances_.bytes() +
+               impulse_per_weight_.bytes() +
                backend_scratch_bytes();
     }
     double time() const override { return time_; }
     std::string backend_name() const override { return kBackendName; }
     std::string device_name() const override { return device_description(); }
     std::vector<std::array<double, 3>> fluid_force_on_solids() const override { return solids_.object_forces(); }
+    std::vector<std::array<double, 3>> pending_contact_impulse() const override {
+        return solids_.object_contact_impulses();
+    }
 
    private:
     // The PCISPH loop over a neighbourhood (the grid, or this step's lists): predict, density and
@@ -189,7 +225,8 @@ class BackendSimulation final : public Simulation {
     enum class PcisphOutcome { kConverged, kDiverged, kOutOfIterations };
     template <class Neighbors>
     DensityError pcisph_iterations(const Neighbors& neighbors, std::size_t fluid_count, const Vec3* nonpressure,
-                                   Real delta, Real dt, int& iterations, PcisphOutcome& outcome) {
+                                   const SolidSurface& solid_surface, Real delta, Real dt, int& iterations,
+                                   PcisphOutcome& outcome) {
         const SolverParams& solver = params_.solver;
         DensityError error;
         iterations = 0;
@@ -200,7 +237,7 @@ class BackendSimulation final : public Simulation {
             const bool first = iterations == 0;
             predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
                               first ? nullptr : pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt,
-                              wall_contact_);
+                              wall_contact_, solid_surface);
             predict_density_and_pressure(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
                                          boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
                                          pressure_term_.view(), fluid_, delta, first);
@@ -230,9 +267,20 @@ class BackendSimulation final : public Simulation {
         return error;
     }
 
-    enum Stage { kNeighbors, kSolidVolumes, kViscosity, kPcisph, kCoupling, kLsm, kIntegrate, kStageCount };
-    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "solid_volumes", "viscosity", "pcisph",
-                                                             "coupling",  "lsm",           "integrate"};
+    enum Stage {
+        kNeighbors,
+        kSolidVolumes,
+        kViscosity,
+        kPcisph,
+        kCoupling,
+        kLsm,
+        kIntegrate,
+        kSolidContact,
+        kStageCount
+    };
+    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "solid_volumes", "viscosity",
+                                                             "pcisph",    "coupling",      "lsm",
+                                                             "integrate", "solid_contact"};
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
@@ -296,6 +344,9 @@ class BackendSimulation final : public Simulation {
     bool has_fluid_ = false;
     bool has_solid_volumes_ = false;  // moving solids and fluid: boundary volumes every step
     bool has_coupling_ = false;       // ... and two-way coupling: the fluid's forces act on them
+    bool has_solid_contact_ = false;  // ... and the velocity–position correction against them
+    DeviceArray<Vec3> impulse_per_weight_;  // the correction's, per fluid particle (two-way only)
+    Real contact_band_ = 0;                 // its band c, m
     SolidBodies solids_;
     ParticleCounts counts_;
     long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
@@ -411,6 +462,10 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     has_viscosity_ = has_fluid_ && (fp.viscosity > 0 || (fp.wall_viscosity > 0 && store_.static_count() > 0));
     has_solid_volumes_ = solids_.active() && has_fluid_;
     has_coupling_ = has_solid_volumes_ && solids_.coupled();
+    has_solid_contact_ = has_solid_volumes_ && params_.solid_correction;
+    contact_band_ = static_cast<Real>(kMovingSolidContact * fp.spacing);
+    if (!(params_.solid_slip >= 0 && params_.solid_slip <= 1))
+        throw InputError("simulation setup: the solids' slip factor must be in [0, 1]");
 
     // Boundary volumes only matter to fluid next to boundary particles: without fluid, or without
     // any boundary particle, they are neither stored nor computed. They are indexed like the store
@@ -425,6 +480,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
         predicted_.resize(moving);
     }
     if (has_viscosity_) nonpressure_.resize(moving);
+    if (has_solid_contact_ && solids_.contact_takes_impulses()) impulse_per_weight_.resize(moving);
 
     active_stages_.push_back(kNeighbors);
     if (has_solid_volumes_) active_stages_.push_back(kSolidVolumes);
@@ -433,6 +489,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (has_coupling_) active_stages_.push_back(kCoupling);
     if (solids_.active()) active_stages_.push_back(kLsm);
     if (has_fluid_) active_stages_.push_back(kIntegrate);
+    if (has_solid_contact_) active_stages_.push_back(kSolidContact);
 
     // One neighbour build now, so that every per-step buffer (sort keys, lists) is allocated
     // before the first step and device_bytes() is the steady-state figure `info` reports.

@@ -70,6 +70,9 @@ struct ContactField {
 
 // The band of static mesh objects, in r0 (see the header comment).
 constexpr double kStaticObjectContact = 0.45;
+// The band of moving (elastic and rigid) objects, in r0, for their own correction
+// (solid_contact.hpp): as static mesh objects', which are sampled the same way.
+constexpr double kMovingSolidContact = kStaticObjectContact;
 
 struct WallContact {
     static constexpr Real kFar = std::numeric_limits<Real>::max();

@@ -157,12 +157,20 @@ int command_info(int argc, char** argv) {
     if (moving_objects && !scene.fluid_blocks.empty()) {
         if (scene.params.two_way_coupling)
             std::printf("coupling    two-way (coupling.two_way): the fluid's pressure%s acts back on %ld moving "
-                        "object(s), through their LSM regions; no velocity-position correction against them yet\n",
+                        "object(s), through their LSM regions\n",
                         f.wall_viscosity > 0 ? " and friction" : "", moving_objects);
         else
             std::printf("coupling    one-way (coupling.two_way false): %ld moving object(s) push the fluid and "
                         "feel none of it\n",
                         moving_objects);
+        if (scene.params.solid_correction)
+            std::printf("            velocity-position correction against them on (coupling.correction): fluid moving "
+                        "into one stops %.2f r0 from its surface particles%s, slip %g\n",
+                        kMovingSolidContact,
+                        scene.params.two_way_coupling ? " and trades momentum with it" : " and takes its velocity",
+                        double(scene.params.solid_slip));
+        else
+            std::printf("            velocity-position correction against them off (coupling.correction false)\n");
     }
     if (const std::string warning = scene.kernel_warning(); !warning.empty())
         std::printf("warning     %s\n", warning.c_str());

@@ -406,6 +406,8 @@ void read_coupling(Section s, Scene& scene) {
     // Off unless the scene asks, like every physics switch added after the first release
     // (scenes/floating_boxes.json asks).
     scene.params.two_way_coupling = s.boolean("two_way", false);
+    scene.params.solid_correction = s.boolean("correction", false);
+    scene.params.solid_slip = Real(s.number("slip", 1.0, Range{0, 1}));
     s.finish();
 }
 

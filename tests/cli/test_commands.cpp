@@ -858,3 +858,48 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
     CHECK(contains(wrong_type.err, "coupling.two_way"));
     CHECK(contains(wrong_type.err, "true or false"));
 }
+
+TEST_CASE("info: the velocity-position correction against moving objects is a stage after the integration") {
+    const std::string scene = scene_file(
+        "corrected.json",
+        tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
+                                          "transform": {"translation": [0.15, 0.1, 0.1]}, "kind": "rigid", "density": 500}])"));
+    const auto stages_of = [](const Result& r) {
+        const auto j = nlohmann::json::parse(r.out);
+        std::vector<std::string> names;
+        for (const auto& s : j["stages"]) names.push_back(s.get<std::string>());
+        return names;
+    };
+    const Result on = run("info " + scene + " --json --set coupling.two_way=true --set coupling.correction=true");
+    CAPTURE(on.err);
+    REQUIRE(on.code == 0);
+    const std::vector<std::string> with = stages_of(on);
+    const auto integrate = std::find(with.begin(), with.end(), "integrate"),
+               contact = std::find(with.begin(), with.end(), "solid_contact");
+    REQUIRE(contact != with.end());
+    CHECK(integrate < contact);
+    const auto resolved = nlohmann::json::parse(on.out)["scene"]["coupling"];
+    CHECK(resolved["correction"] == true);
+    CHECK(resolved["slip"] == 1.0);
+    CHECK(contains(run("info " + scene + " --set coupling.two_way=true --set coupling.correction=true").out,
+                   "trades momentum with it"));
+    // One-way too: the objects are then infinitely heavy, and the fluid takes their velocity.
+    const Result one_way = run("info " + scene + " --set coupling.correction=true");
+    REQUIRE(one_way.code == 0);
+    CHECK(contains(one_way.out, "takes its velocity"));
+
+    // Off by default, like every physics switch added after the first release.
+    const Result off = run("info " + scene + " --json --set coupling.two_way=true");
+    REQUIRE(off.code == 0);
+    CHECK(nlohmann::json::parse(off.out)["scene"]["coupling"]["correction"] == false);
+    const std::vector<std::string> without = stages_of(off);
+    CHECK(std::find(without.begin(), without.end(), "solid_contact") == without.end());
+    CHECK(contains(run("info " + scene).out, "correction against them off (coupling.correction false)"));
+
+    const Result slip = run("info " + scene + " --set coupling.correction=true --set coupling.slip=1.5");
+    CHECK(slip.code != 0);
+    CHECK(contains(slip.err, "coupling.slip"));
+    const Result wrong_type = run("info " + scene + " --set coupling.correction=1");
+    CHECK(wrong_type.code != 0);
+    CHECK(contains(wrong_type.err, "coupling.correction"));
+}

@@ -190,3 +190,32 @@ TEST_CASE("CUDA and OpenMP agree on fluid around a moving solid: a cube thrown i
         CHECK(cube_bottom < 0.15);
     }
 }
+
+TEST_CASE("CUDA and OpenMP agree on the velocity-position correction against a moving solid, two-way, 40 steps") {
+    if (!cuda_backend_info().available) {
+        MW_SKIP(cuda_backend_info().description);
+        return;
+    }
+    // The same throw with the fluid pushing back (coupling.two_way) and the correction against the
+    // cube's SBPs (coupling.correction): its position rule in PCISPH, the virtual particles, the
+    // SBPs' gather of the impulses and their arrival in the next step's coupling, on both backends.
+    for (const auto lists : test::kGatherModes) {
+        const std::string variant = test::gather_mode_name(lists);
+        CAPTURE(variant);
+        SimulationSetup setup = cube_into_pool(lists);
+        setup.params.two_way_coupling = true;
+        setup.params.solid_correction = true;
+        const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 40);
+        const HostParticles &a = runs.openmp, &b = runs.cuda;
+        REQUIRE(a.position.size() == b.position.size());
+        const double domain_size = norm(setup.params.domain_max - setup.params.domain_min);
+        const double worst_fluid = test::largest_position_difference(a, b, [](std::uint8_t t) { return t == kFluid; });
+        const double worst_solid = test::largest_position_difference(a, b, [](std::uint8_t t) { return t != kFluid; });
+        MESSAGE("largest position difference after 40 steps: fluid " << worst_fluid << " m, solid " << worst_solid
+                                                                      << " m");
+        CHECK(worst_fluid < 1e-4 * domain_size);
+        CHECK(worst_solid < 1e-4 * domain_size);
+        CHECK(runs.openmp_report.lost_particles == 0);
+        CHECK(runs.cuda_report.lost_particles == 0);
+    }
+}
