@@ -21,7 +21,6 @@
 
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/particle_types.hpp"
-#include "algorithms/wall_contact.hpp"
 
 namespace mw {
 

@@ -810,17 +810,24 @@ TEST_CASE("guards: a run that loses more fluid through its walls than boundary.m
     }
 }
 
-TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, when the scene asks for it") {
-    const std::string scene = scene_file(
-        "coupled.json",
-        tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
+namespace {
+// The tiny scene with a rigid box (0.06 m, 500 kg/m3) beside its fluid, written as `name` (the
+// coupling's tests).
+std::string tiny_scene_with_box(const std::string& name) {
+    return scene_file(name, tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
                                           "transform": {"translation": [0.15, 0.1, 0.1]}, "kind": "rigid", "density": 500}])"));
-    const auto stages_of = [](const Result& r) {
-        const auto j = nlohmann::json::parse(r.out);
-        std::vector<std::string> names;
-        for (const auto& s : j["stages"]) names.push_back(s.get<std::string>());
-        return names;
-    };
+}
+// The stages `info --json` lists, in order.
+std::vector<std::string> stages_of(const Result& r) {
+    const auto j = nlohmann::json::parse(r.out);
+    std::vector<std::string> names;
+    for (const auto& s : j["stages"]) names.push_back(s.get<std::string>());
+    return names;
+}
+}  // namespace
+
+TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, when the scene asks for it") {
+    const std::string scene = tiny_scene_with_box("coupled.json");
     const Result on = run("info " + scene + " --json --set coupling.two_way=true");
     CAPTURE(on.err);
     REQUIRE(on.code == 0);
@@ -860,16 +867,7 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
 }
 
 TEST_CASE("info: the velocity-position correction against moving objects is a stage after the integration") {
-    const std::string scene = scene_file(
-        "corrected.json",
-        tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
-                                          "transform": {"translation": [0.15, 0.1, 0.1]}, "kind": "rigid", "density": 500}])"));
-    const auto stages_of = [](const Result& r) {
-        const auto j = nlohmann::json::parse(r.out);
-        std::vector<std::string> names;
-        for (const auto& s : j["stages"]) names.push_back(s.get<std::string>());
-        return names;
-    };
+    const std::string scene = tiny_scene_with_box("corrected.json");
     const Result on = run("info " + scene + " --json --set coupling.two_way=true --set coupling.correction=true");
     CAPTURE(on.err);
     REQUIRE(on.code == 0);

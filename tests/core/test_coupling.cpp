@@ -19,44 +19,6 @@
 
 using namespace mw;
 
-namespace {
-
-// A 0.12 m cube of fluid at `speed` along +x toward a cube of solid (0.12 m, density 1000) at rest
-// 2 r0 ahead of it, in an open domain with no gravity.
-struct Throw {
-    static constexpr Real r0 = 0.02f;
-    SimulationSetup setup;
-    double fluid_mass = 0, ibp_mass = 0;
-
-    Throw(SolidKind kind, bool two_way, SimulationParams::Lists lists, Real speed) {
-        setup = test::fluid_in_box({0, 0, 0}, {0.8f, 0.4f, 0.4f}, {0.1f, 0.14f, 0.14f}, {0.22f, 0.26f, 0.26f}, r0,
-                                   0.001f, /*walls=*/false);
-        setup.params.gravity = Vec3{0, 0, 0};
-        setup.params.two_way_coupling = two_way;
-        setup.params.neighbor_lists = lists;
-        for (std::size_t i = 0; i < setup.position.size(); ++i) setup.velocity[i] = Vec3{speed, 0, 0};
-        SolidSetup solid;
-        solid.name = "cube";
-        solid.kind = kind;
-        solid.density = 1000;
-        solid.stiffness = 0.5f;
-        test::add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.22 + 2 * r0 + 0.06, 0.2, 0.2), solid,
-                            Vec3{0, 0, 0});
-        fluid_mass = test::lattice_mass(CubicSpline3D::with_support(2 * r0), r0, 1000.0);
-        ibp_mass = solid.density * double(r0) * r0 * r0;
-    }
-    // Total momentum along x of the fluid and of the IBPs (SBPs and GPs carry no mass).
-    void momentum(const HostParticles& p, double& fluid, double& solid) const {
-        fluid = solid = 0;
-        for (std::size_t i = 0; i < p.position.size(); ++i) {
-            if (p.type[i] == kFluid) fluid += fluid_mass * p.velocity[i].x;
-            if (p.type[i] == kInnerBoundary) solid += ibp_mass * p.velocity[i].x;
-        }
-    }
-};
-
-}  // namespace
-
 TEST_CASE("two-way coupling keeps the momentum of fluid thrown at a free cube, which one-way loses") {
     const test::RestoreThreadCount restore;
     for (const SolidKind kind : {SolidKind::kRigid, SolidKind::kElastic}) {
@@ -64,7 +26,9 @@ TEST_CASE("two-way coupling keeps the momentum of fluid thrown at a free cube, w
             const std::string variant = std::string(kind == SolidKind::kRigid ? "rigid" : "elastic") + ", " +
                                         test::gather_mode_name(lists);
             CAPTURE(variant);
-            const Throw coupled(kind, true, lists, 2.0f);
+            test::CubeThrow coupled(kind, 2.0f, 0.001f);
+            coupled.setup.params.two_way_coupling = true;
+            coupled.setup.params.neighbor_lists = lists;
             const std::unique_ptr<Simulation> sim = create_openmp_simulation(coupled.setup, 2);
             HostParticles p;
             sim->download(p);
@@ -100,7 +64,8 @@ TEST_CASE("two-way coupling keeps the momentum of fluid thrown at a free cube, w
         }
     }
     // The same throw, one-way: the cube pushes the fluid back but feels nothing.
-    const Throw one_way(SolidKind::kRigid, false, SimulationParams::Lists::kOn, 2.0f);
+    test::CubeThrow one_way(SolidKind::kRigid, 2.0f, 0.001f);
+    one_way.setup.params.neighbor_lists = SimulationParams::Lists::kOn;
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(one_way.setup, 2);
     HostParticles p;
     sim->download(p);

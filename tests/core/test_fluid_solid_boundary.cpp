@@ -162,15 +162,16 @@ SimulationSetup cube_into_pool(SimulationParams::Lists lists) {
 }
 }  // namespace
 
-TEST_CASE("CUDA and OpenMP agree on fluid around a moving solid: a cube thrown into a pool, 40 steps") {
-    if (!cuda_backend_info().available) {
-        MW_SKIP(cuda_backend_info().description);
-        return;
-    }
+namespace {
+// Runs cube_into_pool on both backends for 40 steps, with grid gathers and with lists, and checks
+// that they agree; `two_way_corrected` adds two-way coupling and the correction against the cube.
+void cube_into_pool_on_both_backends(bool two_way_corrected) {
     for (const auto lists : test::kGatherModes) {
         const std::string variant = test::gather_mode_name(lists);
         CAPTURE(variant);
-        const SimulationSetup setup = cube_into_pool(lists);
+        SimulationSetup setup = cube_into_pool(lists);
+        setup.params.two_way_coupling = two_way_corrected;
+        setup.params.solid_correction = two_way_corrected;
         const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 40);
         const HostParticles &a = runs.openmp, &b = runs.cuda;
         REQUIRE(a.position.size() == b.position.size());
@@ -181,14 +182,25 @@ TEST_CASE("CUDA and OpenMP agree on fluid around a moving solid: a cube thrown i
         for (std::size_t i = 0; i < a.position.size(); ++i)
             if (a.type[i] == kInnerBoundary) cube_bottom = std::min(cube_bottom, double(a.position[i].y));
         MESSAGE("largest position difference after 40 steps: fluid " << worst_fluid << " m, solid " << worst_solid
+                                                                      << " m; the cube's bottom at " << cube_bottom
                                                                       << " m");
         CHECK(worst_fluid < 1e-4 * domain_size);
         CHECK(worst_solid < 1e-4 * domain_size);
         CHECK(runs.openmp_report.lost_particles == 0);
         CHECK(runs.cuda_report.lost_particles == 0);
-        // And the cube did go in: its lowest IBPs are below the pool's surface (0.2 m).
-        CHECK(cube_bottom < 0.15);
+        // And the cube did go in: its lowest IBPs are below the pool's surface (0.2 m); two-way
+        // the fluid slows it (0.157 m on OpenMP, against below 0.15 m one-way).
+        CHECK(cube_bottom < (two_way_corrected ? 0.17 : 0.15));
     }
+}
+}  // namespace
+
+TEST_CASE("CUDA and OpenMP agree on fluid around a moving solid: a cube thrown into a pool, 40 steps") {
+    if (!cuda_backend_info().available) {
+        MW_SKIP(cuda_backend_info().description);
+        return;
+    }
+    cube_into_pool_on_both_backends(false);
 }
 
 TEST_CASE("CUDA and OpenMP agree on the velocity-position correction against a moving solid, two-way, 40 steps") {
@@ -199,23 +211,5 @@ TEST_CASE("CUDA and OpenMP agree on the velocity-position correction against a m
     // The same throw with the fluid pushing back (coupling.two_way) and the correction against the
     // cube's SBPs (coupling.correction): its position rule in PCISPH, the virtual particles, the
     // SBPs' gather of the impulses and their arrival in the next step's coupling, on both backends.
-    for (const auto lists : test::kGatherModes) {
-        const std::string variant = test::gather_mode_name(lists);
-        CAPTURE(variant);
-        SimulationSetup setup = cube_into_pool(lists);
-        setup.params.two_way_coupling = true;
-        setup.params.solid_correction = true;
-        const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 40);
-        const HostParticles &a = runs.openmp, &b = runs.cuda;
-        REQUIRE(a.position.size() == b.position.size());
-        const double domain_size = norm(setup.params.domain_max - setup.params.domain_min);
-        const double worst_fluid = test::largest_position_difference(a, b, [](std::uint8_t t) { return t == kFluid; });
-        const double worst_solid = test::largest_position_difference(a, b, [](std::uint8_t t) { return t != kFluid; });
-        MESSAGE("largest position difference after 40 steps: fluid " << worst_fluid << " m, solid " << worst_solid
-                                                                      << " m");
-        CHECK(worst_fluid < 1e-4 * domain_size);
-        CHECK(worst_solid < 1e-4 * domain_size);
-        CHECK(runs.openmp_report.lost_particles == 0);
-        CHECK(runs.cuda_report.lost_particles == 0);
-    }
+    cube_into_pool_on_both_backends(true);
 }

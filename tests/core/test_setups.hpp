@@ -291,4 +291,37 @@ inline SettledColumn settle_column(Simulation& sim, const SimulationParams& para
     return out;
 }
 
+// A 0.12 m cube of fluid at `speed` along +x toward a free cube of solid (0.12 m, density 1000,
+// `kind`, stiffness 0.5) at rest 2 r0 ahead of it, in an open domain (0.8 x 0.4 x 0.4 m) with no
+// gravity, r0 = 0.02 m, steps of `dt` (the coupling's momentum tests). Callers switch the
+// coupling, the correction and the gathers in `setup.params`.
+struct CubeThrow {
+    static constexpr Real r0 = 0.02f;
+    SimulationSetup setup;
+    double fluid_mass = 0, ibp_mass = 0;  // kg per fluid particle and per IBP
+
+    CubeThrow(SolidKind kind, Real speed, Real dt) {
+        setup = fluid_in_box({0, 0, 0}, {0.8f, 0.4f, 0.4f}, {0.1f, 0.14f, 0.14f}, {0.22f, 0.26f, 0.26f}, r0, dt,
+                             /*walls=*/false);
+        setup.params.gravity = Vec3{0, 0, 0};
+        for (std::size_t i = 0; i < setup.position.size(); ++i) setup.velocity[i] = Vec3{speed, 0, 0};
+        SolidSetup solid;
+        solid.name = "cube";
+        solid.kind = kind;
+        solid.density = 1000;
+        solid.stiffness = 0.5f;
+        add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.22 + 2 * r0 + 0.06, 0.2, 0.2), solid, Vec3{0, 0, 0});
+        fluid_mass = lattice_mass(CubicSpline3D::with_support(2 * r0), r0, 1000.0);
+        ibp_mass = solid.density * double(r0) * r0 * r0;
+    }
+    // Total momentum along x of the fluid and of the IBPs (SBPs and GPs carry no mass).
+    void momentum(const HostParticles& p, double& fluid, double& solid) const {
+        fluid = solid = 0;
+        for (std::size_t i = 0; i < p.position.size(); ++i) {
+            if (p.type[i] == kFluid) fluid += fluid_mass * p.velocity[i].x;
+            if (p.type[i] == kInnerBoundary) solid += ibp_mass * p.velocity[i].x;
+        }
+    }
+};
+
 }  // namespace mw::test

@@ -29,22 +29,12 @@ struct ThrowOutcome {
 };
 
 ThrowOutcome throw_at_cube(SolidKind kind, bool two_way, bool correction, Real speed, Real dt, int steps) {
-    const Real r0 = 0.02f;
-    SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.8f, 0.4f, 0.4f}, {0.1f, 0.14f, 0.14f},
-                                               {0.22f, 0.26f, 0.26f}, r0, dt, /*walls=*/false);
-    setup.params.gravity = Vec3{0, 0, 0};
+    const Real r0 = test::CubeThrow::r0;
+    test::CubeThrow thrown(kind, speed, dt);
+    SimulationSetup& setup = thrown.setup;
     setup.params.two_way_coupling = two_way;
     setup.params.solid_correction = correction;
-    for (std::size_t i = 0; i < setup.position.size(); ++i) setup.velocity[i] = Vec3{speed, 0, 0};
-    SolidSetup solid;
-    solid.name = "cube";
-    solid.kind = kind;
-    solid.density = 1000;
-    solid.stiffness = 0.5f;
-    test::add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.22 + 2 * r0 + 0.06, 0.2, 0.2), solid,
-                        Vec3{0, 0, 0});
-    const double fluid_mass = test::lattice_mass(CubicSpline3D::with_support(2 * r0), r0, 1000.0);
-    const double ibp_mass = solid.density * double(r0) * r0 * r0;
+    const double fluid_mass = thrown.fluid_mass, ibp_mass = thrown.ibp_mass;
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 2);
 
     ThrowOutcome out;
