@@ -85,23 +85,20 @@ inline void correct_fluid_at_solids(std::size_t fluid_count, View<const Vec3> po
                                     const SolidContactData d, const WallContact walls) {
     parallel_for("solid_contact_fluid", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 x = position[i], v = velocity[i];
-        const VirtualBoundary k = d.surface.collide(static_cast<std::uint32_t>(i), x, v, position, velocity,
+        const VirtualBoundary k = d.surface.collide(static_cast<std::uint32_t>(i), x, position, velocity,
                                                     d.sbp_inverse_mass);
         Vec3 xc = x, vc = v, impulse{0, 0, 0};
-        if (k.found()) {
+        Real depth = 0;
+        if (d.surface.collides(k, x, v, depth)) {
             const Vec3 nk = k.normal;
-            const Real depth = dot(x - k.position, nk);
+            xc = x + (d.surface.band - depth) * nk;
+            // Δv_i = -(m_k / (m_i + m_k)) (u_n + (1 - ∂) u_t), and the solid's J = -m_i Δv_i.
             const Vec3 u = v - k.velocity;
-            const Real un = dot(u, nk);
-            if (depth < d.surface.band) xc = x + (d.surface.band - depth) * nk;
-            if (depth < d.surface.band && un < Real(0)) {
-                // Δv_i = -(m_k / (m_i + m_k)) (u_n + (1 - ∂) u_t), and the solid's J = -m_i Δv_i.
-                const Vec3 u_normal = un * nk;
-                const Vec3 change = u_normal + (Real(1) - d.slip) * (u - u_normal);
-                const Real share = d.fluid_inverse_mass / (d.fluid_inverse_mass + k.inverse_mass);
-                vc = v - share * change;
-                impulse = (share / d.fluid_inverse_mass) * change;
-            }
+            const Vec3 u_normal = dot(u, nk) * nk;
+            const Vec3 change = u_normal + (Real(1) - d.slip) * (u - u_normal);
+            const Real share = d.fluid_inverse_mass / (d.fluid_inverse_mass + k.inverse_mass);
+            vc = v - share * change;
+            impulse = (share / d.fluid_inverse_mass) * change;
             walls.correct(xc, vc);
         }
         out_position[i] = xc;
@@ -111,18 +108,18 @@ inline void correct_fluid_at_solids(std::size_t fluid_count, View<const Vec3> po
     });
 }
 
-// Per SBP (two-way): its shares of the impulses of the fluid particles that collided with it,
-// from the fluid's positions and velocities before the correction.
-inline void gather_sbp_impulses(std::size_t fluid_end, std::size_t solid_end,
-                                View<const Vec3> position, View<const Vec3> velocity, const SolidContactData d) {
+// Per SBP (two-way): its shares of the impulses of the fluid particles that collided with the
+// virtual particles it is part of, from the fluid's positions before the correction.
+inline void gather_sbp_impulses(std::size_t fluid_end, std::size_t solid_end, View<const Vec3> position,
+                                const SolidContactData d) {
     parallel_for("solid_contact_sbp", d.surface.sbp_count, [=] MW_HD(std::size_t k) {
         const SolidSurface& surface = d.surface;
         const std::uint32_t b = d.store_of_slot[surface.ibp_count + k];
         Vec3 sum{0, 0, 0};
         if (b >= fluid_end && b < solid_end) {  // an SBP that left the grid meets no fluid
-            const Vec3 xs = position[b], vs = velocity[b], ns = surface.sbp_normal[k];
+            const Vec3 xs = position[b];
             surface.grid.for_each_fluid_around_particle(b, [&](std::uint32_t i) {
-                const Real w = penetration_weight(position[i], velocity[i], xs, vs, ns, surface.reach);
+                const Real w = contact_weight(position[i], xs, surface.reach);
                 if (w > Real(0)) sum += w * d.impulse_per_weight[i];
             });
         }

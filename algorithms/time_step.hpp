@@ -155,8 +155,7 @@ class BackendSimulation final : public Simulation {
                 View<Vec3> corrected_position = predicted_.view(), corrected_velocity = pressure_acc_.view();
                 correct_fluid_at_solids(fluid_count, store_.position.cview(), store_.velocity.cview(),
                                         corrected_position, corrected_velocity, contact, wall_contact_);
-                gather_sbp_impulses(ranges_.fluid_end, ranges_.solid_end, store_.position.cview(),
-                                    store_.velocity.cview(), contact);
+                gather_sbp_impulses(ranges_.fluid_end, ranges_.solid_end, store_.position.cview(), contact);
                 apply_fluid_correction(fluid_count, corrected_position, corrected_velocity, store_.position.view(),
                                        store_.velocity.view());
             } else {

@@ -3,18 +3,35 @@
 // to an elastic or rigid object's surface particles (SBPs). Read by the correction after the
 // integration (solid_contact.hpp) and by its position rule inside the PCISPH loop (pcisph.hpp).
 //
-//   P     = the SBPs s with |x_i - x_s| < r0 and (v_i - v_s)·n_s < 0 (the paper's test)
+//   S     = the SBPs s with |x_i - x_s| < r0
 //   w_s   = (1 - |x_i - x_s| / r0)³ (the paper's W(x, r0), from [YLHQ12])
-//   x_k, v_k, n_k = the w-weighted means over P (n_k normalised); 1/m_k the w-weighted mean of
+//   x_k, v_k, n_k = the w-weighted means over S (n_k normalised); 1/m_k the w-weighted mean of
 //           the SBPs' inverse contact masses (0: infinitely heavy)
+//   the particle collides when it lies within the band c of k's surface (below) and moves into
+//   it: (v_i - v_k)·n_k < 0
 // The paper weights by m_s w_s; weighting by w_s alone keeps infinitely heavy SBPs (one-way
 // coupling, pinned lattice) finite, and the contact masses of one object's SBPs differ little.
 //
-// The correction then acts only within the band c = kMovingSolidContact r0 of the virtual
-// particle's plane: fluid at rest lies 0.65-0.8 r0 from an object's SBPs (0.81 r0 under a
-// floating box, docs/coupling.md), which a band of r0 would hold on its edge, as it did at the
-// walls before their band was narrowed (wall_contact.hpp). The test radius stays r0, so that
-// fluid up to r0 inside the surface is still found and put back.
+// The paper builds k from P, the SBPs of S that the particle moves into ((v_i - v_s)·n_s < 0),
+// and so did this code until the twentieth session. Measured then: the SBPs along a box's edge
+// belong to one of its two faces, and a fluid particle resting beside the other face, moving
+// into a few of the first face's edge SBPs (up to r0 away, weights down to 1e-6) but not into
+// its own face's, got a k on the first face's plane, which, extended past the edge, put it up to
+// 1.1 r0 "inside": the correction pushed it 0.4-1.1 r0 along the wrong face, and the pool of
+// scenes/floating_boxes.json ran at up to 4.5 m/s with the correction against 1.0 m/s without
+// it. Built from S, k describes the surface as the density sees it, and the pool runs as calm
+// with the correction as without it. The cost, in fluid thrown at a cube at 4-6 times the CFL
+// step: more particles get in than with P (docs/coupling.md, "Measured").
+//
+// k's surface is a disc of radius kSurfacePatchRadius r0 round x_k in k's plane: a particle
+// beside the disc (past an edge of the object, where S holds only the SBPs nearest the edge) is
+// as far from the surface as from the disc's rim, not as far as from the plane.
+//
+// The correction acts only within the band c = kMovingSolidContact r0 of that surface: fluid at
+// rest lies 0.65-0.8 r0 from an object's SBPs (0.81 r0 under a floating box, docs/coupling.md),
+// which a band of r0 would hold on its edge, as it did at the walls before their band was
+// narrowed (wall_contact.hpp). The test radius stays r0, so that fluid up to r0 inside the
+// surface is still found and put back.
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -24,22 +41,36 @@
 
 namespace mw {
 
-// The pair test and weight, one expression wherever it is evaluated (the fluid's gather and the
-// SBPs' must agree to the bit): w_s when fluid particle (x, v) is within `reach` of SBP s and
-// moving into it, else 0.
-MW_INLINE Real penetration_weight(Vec3 x, Vec3 v, Vec3 xs, Vec3 vs, Vec3 ns, Real reach) {
-    const Vec3 d = x - xs;
-    const Real d2 = norm2(d);
-    if (!(d2 < reach * reach) || !(dot(v - vs, ns) < Real(0))) return Real(0);
+// w_s when fluid particle x is within `reach` of SBP s, else 0: one expression wherever it is
+// evaluated (the fluid's gather and the SBPs' must agree to the bit).
+MW_INLINE Real contact_weight(Vec3 x, Vec3 xs, Real reach) {
+    const Real d2 = norm2(x - xs);
+    if (!(d2 < reach * reach)) return Real(0);
     const Real t = Real(1) - std::sqrt(d2) / reach;
     return t * t * t;
 }
 
+// The radius of the virtual particle's surface, in r0: the least distance between two SBPs
+// (sampling/surface_sampler.hpp). Measured on scenes/floating_boxes.json to t = 1 s (top fluid
+// speed; 1.02 m/s without the correction): 1.22 m/s at r0/2, and 3.51 m/s with the plane alone.
+constexpr double kSurfacePatchRadius = 0.5;
+
 struct VirtualBoundary {
-    Real weight = 0;  // Σ w_s; 0: no SBP in P
+    Real weight = 0;  // Σ w_s; 0: no SBP within r0
     Vec3 position{0, 0, 0}, velocity{0, 0, 0}, normal{0, 0, 0};
     Real inverse_mass = 0;
     MW_INLINE bool found() const { return weight > Real(0); }
+
+    // How far x lies in front of the disc of radius `patch` round `position` (negative: behind
+    // its plane, within the disc's radius of `position`).
+    MW_INLINE Real depth(Vec3 x, Real patch) const {
+        const Vec3 d = x - position;
+        const Real in_front = dot(d, normal);
+        const Real beside = norm(d - in_front * normal) - patch;
+        return beside > Real(0) ? std::sqrt(in_front * in_front + beside * beside) : in_front;
+    }
+    // Whether fluid at velocity v moves into it.
+    MW_INLINE bool approached_by(Vec3 v) const { return dot(v - velocity, normal) < Real(0); }
 };
 
 }  // namespace mw
@@ -58,23 +89,23 @@ struct SolidSurface {
 
     MW_INLINE bool active() const { return sbp_normal != nullptr; }
 
-    // The virtual particle that fluid particle i at (x, v) collides with: a gather over the SBPs
-    // around the cell i was sorted into at this step's build (neighbor_grid.hpp), from the store's
-    // positions and velocities. A virtual particle whose normals cancel is none.
-    MW_INLINE VirtualBoundary collide(std::uint32_t i, Vec3 x, Vec3 v, View<const Vec3> position,
+    // The virtual particle fluid particle i at x faces: a gather over the SBPs around the cell i
+    // was sorted into at this step's build (neighbor_grid.hpp), from the store's positions and
+    // velocities. A virtual particle whose normals cancel is none.
+    MW_INLINE VirtualBoundary collide(std::uint32_t i, Vec3 x, View<const Vec3> position,
                                       View<const Vec3> velocity, const Real* sbp_inverse_mass) const {
         VirtualBoundary k;
         Vec3 normal_sum{0, 0, 0};
         grid.for_each_solid_around_particle(i, [&](std::uint32_t j) {
             if (type[j] != kSurfaceBoundary) return;
-            const std::uint32_t s = static_cast<std::uint32_t>(solid_slot[j]) - ibp_count;
-            const Vec3 xs = position[j], vs = velocity[j], ns = sbp_normal[s];
-            const Real w = penetration_weight(x, v, xs, vs, ns, reach);
+            const Vec3 xs = position[j];
+            const Real w = contact_weight(x, xs, reach);
             if (!(w > Real(0))) return;
+            const std::uint32_t s = static_cast<std::uint32_t>(solid_slot[j]) - ibp_count;
             k.weight += w;
             k.position += w * xs;
-            k.velocity += w * vs;
-            normal_sum += w * ns;
+            k.velocity += w * velocity[j];
+            normal_sum += w * sbp_normal[s];
             if (sbp_inverse_mass) k.inverse_mass += w * sbp_inverse_mass[s];
         });
         const Real length = norm(normal_sum);
@@ -87,15 +118,22 @@ struct SolidSurface {
         return k;
     }
 
-    // The position rule alone, for a PCISPH prediction x* with velocity v* (against the SBPs where
-    // they are at the start of the step, where the density sees them): x* moves along n_k until
-    // it is c from the virtual particle's plane.
+    // Whether fluid particle x moving at v collides with k: within the band of its surface and
+    // moving into it. `depth` receives how far x lies in front of that surface.
+    MW_INLINE bool collides(const VirtualBoundary& k, Vec3 x, Vec3 v, Real& depth) const {
+        if (!k.found()) return false;
+        depth = k.depth(x, Real(kSurfacePatchRadius) * reach);
+        return depth < band && k.approached_by(v);
+    }
+
+    // The position rule alone, for a PCISPH prediction x* of a particle that started the step at
+    // velocity v (against the SBPs where they are at the start of the step, where the density
+    // sees them): x* moves along n_k until it is c in front of k's surface.
     MW_INLINE Vec3 correct_predicted(std::uint32_t i, Vec3 x, Vec3 v, View<const Vec3> position,
                                      View<const Vec3> velocity) const {
-        const VirtualBoundary k = collide(i, x, v, position, velocity, nullptr);
-        if (!k.found()) return x;
-        const Real depth = dot(x - k.position, k.normal);
-        return depth < band ? x + (band - depth) * k.normal : x;
+        const VirtualBoundary k = collide(i, x, position, velocity, nullptr);
+        Real depth = 0;
+        return collides(k, x, v, depth) ? x + (band - depth) * k.normal : x;
     }
 };
 

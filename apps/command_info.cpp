@@ -165,7 +165,7 @@ int command_info(int argc, char** argv) {
                         moving_objects);
         if (scene.params.solid_correction)
             std::printf("            velocity-position correction against them on (coupling.correction): fluid moving "
-                        "into one stops %.2f r0 from its surface particles%s, slip %g\n",
+                        "into one stops %.2f r0 from its surface%s, slip %g\n",
                         kMovingSolidContact,
                         scene.params.two_way_coupling ? " and trades momentum with it" : " and takes its velocity",
                         double(scene.params.solid_slip));
