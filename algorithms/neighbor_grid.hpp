@@ -177,6 +177,12 @@ struct GridView {
         shape.cell_of_key(sorted_key[i], c);
         for_each_in_ranges_around(begin + shape.cell_count, end + shape.cell_count, c, f);
     }
+    // Whether for_each_solid_around_particle(i, ...) visits any particle.
+    MW_INLINE bool has_solid_around_particle(std::uint32_t i) const {
+        bool any = false;
+        for_each_solid_around_particle(i, [&](std::uint32_t) { any = true; });
+        return any;
+    }
     template <class F>
     MW_INLINE void for_each_static(Vec3 x, F&& f) const {
         if (static_begin) for_each_in_ranges(static_begin, static_end, x, f);

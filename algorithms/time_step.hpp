@@ -45,6 +45,7 @@ class BackendSimulation final : public Simulation {
             // the density error (measured: docs/solver.md).
             lists_.build(grid, fluid_count, store_.position.cview(), fluid_.kernel.h, neighbor_count_->view());
         }
+        if (has_solid_contact_) mark_fluid_near_solids(fluid_count, grid, fluid_near_solid_.view());
         timers_.stop(kNeighbors);
 
         // 2. Boundary volumes of moving solids (static ones were computed once).
@@ -72,8 +73,11 @@ class BackendSimulation final : public Simulation {
         const Vec3* nonpressure = has_viscosity_ ? nonpressure_.view().data() : nullptr;
         // The moving solids' surface for the velocity–position correction (its position rule in
         // PCISPH, then the whole rule after the integration); none without it.
-        const SolidSurface solid_surface =
-            has_solid_contact_ ? solids_.surface(store_, grid, contact_band_, params_.fluid.spacing) : SolidSurface{};
+        SolidSurface solid_surface;
+        if (has_solid_contact_) {
+            solid_surface = solids_.surface(store_, grid, contact_band_, params_.fluid.spacing);
+            solid_surface.fluid_near_solid = fluid_near_solid_.view().data();
+        }
 
         // 4. PCISPH: predict, density, pressure, pressure force, until the average density
         //    error is below η (at least min, at most max iterations).
@@ -197,7 +201,7 @@ class BackendSimulation final : public Simulation {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
                pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
                contact_boxes_.bytes() + contact_objects_.bytes() + contact_object_distances_.bytes() +
-               impulse_per_weight_.bytes() +
+               impulse_per_weight_.bytes() + fluid_near_solid_.bytes() +
                backend_scratch_bytes();
     }
     double time() const override { return time_; }
@@ -345,6 +349,7 @@ class BackendSimulation final : public Simulation {
     bool has_coupling_ = false;       // ... and two-way coupling: the fluid's forces act on them
     bool has_solid_contact_ = false;  // ... and the velocity–position correction against them
     DeviceArray<Vec3> impulse_per_weight_;  // the correction's, per fluid particle (two-way only)
+    DeviceArray<std::uint8_t> fluid_near_solid_;  // its gathers' mask, per fluid particle (virtual_boundary.hpp)
     Real contact_band_ = 0;                 // its band c, m
     SolidBodies solids_;
     ParticleCounts counts_;
@@ -480,6 +485,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     }
     if (has_viscosity_) nonpressure_.resize(moving);
     if (has_solid_contact_ && solids_.contact_takes_impulses()) impulse_per_weight_.resize(moving);
+    if (has_solid_contact_) fluid_near_solid_.resize(moving);
 
     active_stages_.push_back(kNeighbors);
     if (has_solid_volumes_) active_stages_.push_back(kSolidVolumes);
