@@ -6,6 +6,8 @@
 //    exactly the terms the fluid summed (no float atomics, so it is deterministic):
 //      pressure (Akinci 2012; pcisph.hpp)  F_b = Σ_i m ψ_b (p_i/ρ_i²) ∇W(x*_i - x_b)
 //      friction (Eq. 8, when on)           F_b = -Σ_i m (μ_w/ρ0) V_b ∇²W(x_i - x_b) (v_b - v_i)
+//      interface tension (Eq. 9, SBPs)     F_s = Σ_i η_s m ρ0 V_s W(x_is) x_is / |x_is|
+//                                          (interface_tension.hpp; positions of the step's start)
 //    with the last PCISPH iteration's predicted positions x* and pressures, so that the pair's
 //    two forces cancel to rounding: the fluid and the solids together conserve momentum. With the
 //    velocity–position correction against solids on, an SBP's reaction also carries the impulse
@@ -89,6 +91,8 @@ struct CouplingData {
     // null without it, solid_contact.hpp): they join this step's reaction as J / Δt.
     const Vec3* sbp_contact_impulse = nullptr;
     Real inverse_dt = 0;
+    // Interface tension's η per SBP (interface_tension.hpp); null: none.
+    const Real* sbp_eta = nullptr;
 };
 
 // The pairs the fluid summed: in grid mode all in the 27 cells (the relation is symmetric:
@@ -116,16 +120,24 @@ void fluid_reaction_on_solids(const FluidPairs pairs, const CouplingData d, View
             return;
         }
         const Vec3 xb = position[b], vb = velocity[b];
-        Vec3 pressure_sum{0, 0, 0}, friction_sum{0, 0, 0};
+        const Real eta = d.sbp_eta && s >= d.ibp_count ? d.sbp_eta[s - d.ibp_count] : Real(0);
+        Vec3 pressure_sum{0, 0, 0}, friction_sum{0, 0, 0}, tension_sum{0, 0, 0};
         pairs.grid.for_each_fluid(xb, [&](std::uint32_t i) {
             const Vec3 xi = position[i];
             const Real paired = lists ? (norm2(xi - xb) < pairs.list_radius2 ? Real(1) : Real(0)) : Real(1);
             const Vec3 r = predicted[i] - xb;
             pressure_sum += (paired * pressure_term[i]) * c.kernel.grad_W_r2(r, norm2(r));
             if (friction) friction_sum += c.kernel.laplacian_visc_r2(norm2(xi - xb)) * (vb - velocity[i]);
+            if (eta > Real(0)) {
+                const Vec3 x_is = xi - xb;
+                const Real r2 = norm2(x_is);
+                const Real w = c.kernel.W_r2(r2);
+                if (w > Real(0) && r2 > Real(0)) tension_sum += (w / std::sqrt(r2)) * x_is;
+            }
         });
         const Real vb_volume = boundary_volume[b];
-        Vec3 reaction = (pressure_scale * vb_volume) * pressure_sum + (friction_scale * vb_volume) * friction_sum;
+        Vec3 reaction = (pressure_scale * vb_volume) * pressure_sum + (friction_scale * vb_volume) * friction_sum +
+                        (pressure_scale * vb_volume * eta) * tension_sum;
         if (d.sbp_contact_impulse && s >= d.ibp_count)
             reaction += d.inverse_dt * d.sbp_contact_impulse[s - d.ibp_count];
         d.reaction[s] = reaction;

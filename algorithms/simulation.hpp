@@ -110,6 +110,7 @@ struct SolidSetup {
     Real stiffness = 1;           // α in (0, 1]
     Real damping = 0;             // 1/s: rate at which non-rigid velocity in each region decays
     Real wall_friction = 0.2;     // [0, 1]: share of tangential velocity removed per wall contact
+    Real interface_tension = 0;   // η of Eq. 9 between its SBPs and the fluid, m⁴ kg⁻¹ s⁻² (interface_tension.hpp)
     // IBPs: index in the setup's lists, integer lattice coordinates, pinned flag (empty = none).
     std::vector<std::uint32_t> ibp;
     std::vector<std::array<int, 3>> lattice;

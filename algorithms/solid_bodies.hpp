@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "algorithms/coupling.hpp"
+#include "algorithms/interface_tension.hpp"
 #include "algorithms/lsm.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
@@ -111,6 +112,16 @@ class SolidBodies {
         sbp_normal_.upload(L.sbp_normal);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
+        // Interface tension (interface_tension.hpp): each SBP's η, its object's; none stored when
+        // no object has any.
+        std::vector<Real> sbp_eta(sbp_count_, Real(0));
+        bool any_tension = false;
+        for (std::size_t k = 0; k < sbp_count_; ++k) {
+            const std::int32_t o = setup.object[L.scene_index[ibp_count_ + k]];
+            sbp_eta[k] = setup.solids[std::size_t(o)].interface_tension;
+            any_tension = any_tension || sbp_eta[k] > Real(0);
+        }
+        if (any_tension) sbp_eta_.upload(sbp_eta);
         // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
         // forces act through the regions (lsm.hpp, LsmData::forces).
         const bool any_fluid = std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end();
@@ -196,6 +207,7 @@ class SolidBodies {
         c.share_sbp = share_sbp_.view().data();
         c.share_weight = share_weight_.view().data();
         if (!sbp_impulse_.empty()) c.sbp_contact_impulse = sbp_impulse_.view().data();
+        if (!sbp_eta_.empty()) c.sbp_eta = sbp_eta_.view().data();
         return c;
     }
 
@@ -232,6 +244,16 @@ class SolidBodies {
     // Whether the correction exchanges momentum with the solids (two-way coupling and the
     // correction on).
     bool contact_takes_impulses() const { return !sbp_impulse_.empty(); }
+    // Interface tension (interface_tension.hpp): whether any object has it, and what its kernel reads.
+    bool has_tension() const { return !sbp_eta_.empty(); }
+    InterfaceTension tension(const ParticleStore& store) const {
+        InterfaceTension t;
+        t.type = store.type.cview();
+        t.solid_slot = solid_slot_->cview();
+        t.sbp_eta = sbp_eta_.empty() ? nullptr : sbp_eta_.view().data();
+        t.ibp_count = static_cast<std::uint32_t>(ibp_count_);
+        return t;
+    }
 
     // The force on each object's IBPs in the last step (N, summed in double on the host),
     // indexed like SimulationSetup::solids; static objects and uncoupled runs give 0. A copy to
@@ -277,7 +299,7 @@ class SolidBodies {
                region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
-               share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes();
+               share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -377,6 +399,7 @@ class SolidBodies {
     DeviceArray<Real> share_weight_;
     // The velocity–position correction under two-way coupling (solid_contact.hpp): per SBP.
     DeviceArray<Real> sbp_inverse_mass_;
+    DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
     DeviceArray<Vec3> sbp_impulse_;
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object, for object_contact_impulses()
 };

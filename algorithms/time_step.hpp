@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "algorithms/coupling.hpp"
+#include "algorithms/interface_tension.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/neighbor_list.hpp"
 #include "algorithms/particle_store.hpp"
@@ -70,7 +71,16 @@ class BackendSimulation final : public Simulation {
                                                fluid_);
             timers_.stop(kViscosity);
         }
-        const Vec3* nonpressure = has_viscosity_ ? nonpressure_.view().data() : nullptr;
+        //    Interface tension (Eq. 9): fluid drawn toward the surface particles of objects with an
+        //    `interface_tension` (interface_tension.hpp).
+        if (has_tension_) {
+            timers_.start(kInterfaceTension);
+            add_interface_tension(grid, fluid_count, store_.position.cview(), boundary_volume_.cview(),
+                                  nonpressure_.view(), solids_.tension(store_), fluid_.kernel, fluid_.rest_density,
+                                  fluid_.gravity, has_viscosity_);
+            timers_.stop(kInterfaceTension);
+        }
+        const Vec3* nonpressure = has_viscosity_ || has_tension_ ? nonpressure_.view().data() : nullptr;
         // The moving solids' surface for the velocity–position correction (its position rule in
         // PCISPH, then the whole rule after the integration); none without it.
         SolidSurface solid_surface;
@@ -274,6 +284,7 @@ class BackendSimulation final : public Simulation {
         kNeighbors,
         kSolidVolumes,
         kViscosity,
+        kInterfaceTension,
         kPcisph,
         kCoupling,
         kLsm,
@@ -281,9 +292,9 @@ class BackendSimulation final : public Simulation {
         kSolidContact,
         kStageCount
     };
-    static constexpr const char* kStageNames[kStageCount] = {"neighbors", "solid_volumes", "viscosity",
-                                                             "pcisph",    "coupling",      "lsm",
-                                                             "integrate", "solid_contact"};
+    static constexpr const char* kStageNames[kStageCount] = {
+        "neighbors", "solid_volumes", "viscosity", "interface_tension", "pcisph",
+        "coupling",  "lsm",           "integrate", "solid_contact"};
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
@@ -344,6 +355,7 @@ class BackendSimulation final : public Simulation {
     StageTimers timers_{kStageCount};
     std::vector<int> active_stages_;
     bool has_viscosity_ = false;
+    bool has_tension_ = false;  // an object with interface tension, and fluid
     bool has_fluid_ = false;
     bool has_solid_volumes_ = false;  // moving solids and fluid: boundary volumes every step
     bool has_coupling_ = false;       // ... and two-way coupling: the fluid's forces act on them
@@ -466,6 +478,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     has_viscosity_ = has_fluid_ && (fp.viscosity > 0 || (fp.wall_viscosity > 0 && store_.static_count() > 0));
     has_solid_volumes_ = solids_.active() && has_fluid_;
     has_coupling_ = has_solid_volumes_ && solids_.coupled();
+    has_tension_ = has_solid_volumes_ && solids_.has_tension();
     has_solid_contact_ = has_solid_volumes_ && params_.solid_correction;
     contact_band_ = static_cast<Real>(kMovingSolidContact * fp.spacing);
     if (!(params_.solid_slip >= 0 && params_.solid_slip <= 1))
@@ -483,13 +496,14 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
         pressure_term_.resize(moving);
         predicted_.resize(moving);
     }
-    if (has_viscosity_) nonpressure_.resize(moving);
+    if (has_viscosity_ || has_tension_) nonpressure_.resize(moving);
     if (has_solid_contact_ && solids_.contact_takes_impulses()) impulse_per_weight_.resize(moving);
     if (has_solid_contact_) fluid_near_solid_.resize(moving);
 
     active_stages_.push_back(kNeighbors);
     if (has_solid_volumes_) active_stages_.push_back(kSolidVolumes);
     if (has_viscosity_) active_stages_.push_back(kViscosity);
+    if (has_tension_) active_stages_.push_back(kInterfaceTension);
     if (has_fluid_) active_stages_.push_back(kPcisph);
     if (has_coupling_) active_stages_.push_back(kCoupling);
     if (solids_.active()) active_stages_.push_back(kLsm);

@@ -171,6 +171,10 @@ int command_info(int argc, char** argv) {
                         double(scene.params.solid_slip));
         else
             std::printf("            velocity-position correction against them off (coupling.correction false)\n");
+        long with_tension = 0;
+        for (const SceneObject& o : scene.objects) with_tension += o.interface_tension > 0 ? 1 : 0;
+        if (with_tension)
+            std::printf("            interface tension (Eq. 9) between the fluid and %ld object(s)\n", with_tension);
     }
     if (const std::string warning = scene.kernel_warning(); !warning.empty())
         std::printf("warning     %s\n", warning.c_str());

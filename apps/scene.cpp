@@ -523,6 +523,9 @@ void read_objects(Section& root, Scene& scene) {
         o.kind = kind == "rigid" ? SolidKind::kRigid : kind == "static" ? SolidKind::kStatic : SolidKind::kElastic;
         o.density = Real(s.number("density", 1000.0, Range::positive()));
         o.velocity = s.vec3("velocity", std::array<double, 3>{0, 0, 0});
+        o.interface_tension = Real(s.number("interface_tension", 0.0, Range::non_negative()));
+        if (o.kind == SolidKind::kStatic && o.interface_tension > 0)
+            s.fail(s.key_path("interface_tension"), "is for elastic and rigid objects (this one is static)");
         read_object_lsm(s.object("lsm"), o);
         read_object_pinned(s.object("pinned"), o);
         scene.objects.push_back(o);

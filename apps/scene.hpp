@@ -38,6 +38,7 @@ struct SceneObject {
     Real stiffness = 1;
     Real damping = 0;
     Real wall_friction = 0.2;
+    Real interface_tension = 0;  // η, Eq. 9 (elastic and rigid objects)
     enum class Pin { kNone, kBox, kHalfSpace } pin = Pin::kNone;
     Vec3 pin_min{}, pin_max{};          // box
     Vec3 pin_point{}, pin_normal{};     // half-space: IBPs with (x - point)·normal < 0 are pinned

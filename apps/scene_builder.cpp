@@ -208,6 +208,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         solid.stiffness = o.stiffness;
         solid.damping = o.damping;
         solid.wall_friction = o.wall_friction;
+        solid.interface_tension = o.interface_tension;
         std::function<bool(const Vec3&)> pinned;
         if (o.pin == SceneObject::Pin::kBox) {
             const Vec3 lo = o.pin_min, hi = o.pin_max;

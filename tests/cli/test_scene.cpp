@@ -217,6 +217,12 @@ TEST_CASE("bad scenes give one line naming the key") {
          {"output.f\\x00ps", "unknown key"}},
         {"misspelt mesh key", tiny_scene_text(R"("objects": [{"mesh": {"fiel": "x.obj"}}])"), {},
          {"objects[0].mesh", "\"fiel\""}},
+        {"negative interface tension",
+         tiny_scene_text(R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "interface_tension": -1}])"), {},
+         {"objects[0].interface_tension", "-1"}},
+        {"interface tension on a static object",
+         tiny_scene_text(R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "kind": "static", "interface_tension": 0.2}])"),
+         {}, {"objects[0].interface_tension", "elastic and rigid", "static"}},
     };
     for (const Case& c : cases) {
         CAPTURE(c.what);
