@@ -28,7 +28,6 @@ struct InterfaceTension {
     View<const std::int32_t> solid_slot;
     const Real* sbp_eta = nullptr;  // η per SBP index; null: no tension anywhere
     std::uint32_t ibp_count = 0;    // SBP k has solid slot ibp_count + k
-    MW_INLINE bool active() const { return sbp_eta != nullptr; }
 };
 
 // a_i += Σ_s -η_s ψ_s W(x_is) x_is / |x_is| (F / m_i) over the SBPs around fluid particle i.

@@ -112,13 +112,14 @@ class SolidBodies {
         sbp_normal_.upload(L.sbp_normal);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
+        sbp_object_.resize(sbp_count_);
+        for (std::size_t k = 0; k < sbp_count_; ++k) sbp_object_[k] = setup.object[L.scene_index[ibp_count_ + k]];
         // Interface tension (interface_tension.hpp): each SBP's η, its object's; none stored when
         // no object has any.
         std::vector<Real> sbp_eta(sbp_count_, Real(0));
         bool any_tension = false;
         for (std::size_t k = 0; k < sbp_count_; ++k) {
-            const std::int32_t o = setup.object[L.scene_index[ibp_count_ + k]];
-            sbp_eta[k] = setup.solids[std::size_t(o)].interface_tension;
+            sbp_eta[k] = setup.solids[std::size_t(sbp_object_[k])].interface_tension;
             any_tension = any_tension || sbp_eta[k] > Real(0);
         }
         if (any_tension) sbp_eta_.upload(sbp_eta);
@@ -139,9 +140,6 @@ class SolidBodies {
             if (setup.params.solid_correction) {
                 sbp_inverse_mass_.upload(sbp_inverse_contact_mass(L, shares));
                 sbp_impulse_.assign(sbp_count_, Vec3{0, 0, 0});
-                sbp_object_.resize(sbp_count_);
-                for (std::size_t k = 0; k < sbp_count_; ++k)
-                    sbp_object_[k] = setup.object[L.scene_index[ibp_count_ + k]];
             }
         }
     }
@@ -259,32 +257,15 @@ class SolidBodies {
     // indexed like SimulationSetup::solids; static objects and uncoupled runs give 0. A copy to
     // the host: for tests and reports, not for the step.
     std::vector<std::array<double, 3>> object_forces() const {
-        std::vector<std::array<double, 3>> total(object_count_, std::array<double, 3>{0, 0, 0});
-        if (!coupled()) return total;
-        const std::vector<Vec3> f = force_.to_host();
-        const std::vector<std::int32_t> object = object_.to_host();
-        for (std::size_t s = 0; s < f.size(); ++s) {
-            std::array<double, 3>& t = total[std::size_t(object[s])];
-            t[0] += f[s].x;
-            t[1] += f[s].y;
-            t[2] += f[s].z;
-        }
-        return total;
+        if (!coupled()) return sum_by_object({}, {});
+        return sum_by_object(force_.to_host(), object_.to_host());
     }
     // The impulse each object's SBPs took in the last step's velocity–position correction, which
     // the next step's coupling applies (kg m/s, summed in double on the host; 0 without it). For
     // tests: momentum is kept only counting it.
     std::vector<std::array<double, 3>> object_contact_impulses() const {
-        std::vector<std::array<double, 3>> total(object_count_, std::array<double, 3>{0, 0, 0});
-        if (sbp_impulse_.empty()) return total;
-        const std::vector<Vec3> impulse = sbp_impulse_.to_host();
-        for (std::size_t k = 0; k < impulse.size(); ++k) {
-            std::array<double, 3>& t = total[std::size_t(sbp_object_[k])];
-            t[0] += impulse[k].x;
-            t[1] += impulse[k].y;
-            t[2] += impulse[k].z;
-        }
-        return total;
+        if (sbp_impulse_.empty()) return sum_by_object({}, {});
+        return sum_by_object(sbp_impulse_.to_host(), sbp_object_);
     }
     View<const Vec3> sbp_normals() const { return sbp_normal_.cview(); }
 
@@ -364,6 +345,19 @@ class SolidBodies {
     }
 
    private:
+    // Per-particle vectors summed in double per object (indexed like SimulationSetup::solids).
+    std::vector<std::array<double, 3>> sum_by_object(const std::vector<Vec3>& values,
+                                                     const std::vector<std::int32_t>& object) const {
+        std::vector<std::array<double, 3>> total(object_count_, std::array<double, 3>{0, 0, 0});
+        for (std::size_t k = 0; k < values.size(); ++k) {
+            std::array<double, 3>& t = total[std::size_t(object[k])];
+            t[0] += values[k].x;
+            t[1] += values[k].y;
+            t[2] += values[k].z;
+        }
+        return total;
+    }
+
     std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0, object_count_ = 0;
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;
@@ -399,9 +393,9 @@ class SolidBodies {
     DeviceArray<Real> share_weight_;
     // The velocity–position correction under two-way coupling (solid_contact.hpp): per SBP.
     DeviceArray<Real> sbp_inverse_mass_;
-    DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
     DeviceArray<Vec3> sbp_impulse_;
-    std::vector<std::int32_t> sbp_object_;  // host: each SBP's object, for object_contact_impulses()
+    DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
+    std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
 };
 
 MW_BACKEND_END

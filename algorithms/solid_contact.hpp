@@ -1,20 +1,22 @@
 // The velocity–position correction against moving solids (METHOD.md step 7; the paper's §3.3,
-// Eqs. 11-17), after the fluid's integration: a fluid particle within r0 of an elastic or rigid
-// object's surface particles (SBPs) and moving into them collides with the virtual boundary
-// particle k built from them (virtual_boundary.hpp), and the pair exchanges momentum.
+// Eqs. 11-17), after the fluid's integration: a fluid particle near an elastic or rigid object's
+// surface particles (SBPs) faces the virtual boundary particle k built from those within r0
+// (virtual_boundary.hpp); when it lies within the band c of k's surface and moves into it, it
+// collides with k, and the pair exchanges momentum.
 //
-// Per fluid particle i (a gather over the SBPs near it; nothing races), within the band c of k's
-// plane (depth = (x_i - x_k)·n_k < c):
-//   position: x_i moves along n_k until it is c from k's plane (only the normal part: the
-//           paper's x̂ = x_k + r0 n_k would also slide it sideways onto x_k)
-//   velocity: when it moves into k, with the relative velocity u = v_i - v_k split along n_k
-//           (u_n) and across it (u_t), Δv_i = -(m_k / (m_i + m_k)) (u_n + (1 - ∂) u_t): the
-//           paper's Eqs. 15 and 17 written in inverse masses, so that an infinitely heavy k
-//           (one-way coupling, pinned lattice) gives v̂ⁿ_i = vⁿ_k exactly
-//   the solid: gets the impulse J = -m_i Δv_i, shared among the SBPs of k by w_s / Σ w (the
-//           paper's Eq. 18 projects the change on each SBP's velocity, which is undefined for an
-//           SBP at rest; METHOD.md). Each SBP gathers its shares from the fluid particles that
-//           chose it, with the same test on the same numbers, so the shares add up to J.
+// Per fluid particle i that collides (a gather over the SBPs near it; nothing races), with depth
+// its distance in front of k's surface (SolidSurface::collides):
+//   position: x_i moves along n_k until it is c in front of k's surface (only the normal part:
+//           the paper's x̂ = x_k + r0 n_k would also slide it sideways onto x_k)
+//   velocity: with the relative velocity u = v_i - v_k split along n_k (u_n) and across it
+//           (u_t), Δv_i = -(m_k / (m_i + m_k)) (u_n + (1 - ∂) u_t): the paper's Eqs. 15 and 17
+//           written in inverse masses, so that an infinitely heavy k (one-way coupling, pinned
+//           lattice) gives v̂ⁿ_i = vⁿ_k exactly
+//   the solid: gets the impulse J = -m_i Δv_i, shared among the SBPs k was built from by
+//           w_s / Σ w (the paper's Eq. 18 projects the change on each SBP's velocity, which is
+//           undefined for an SBP at rest; METHOD.md). Each SBP gathers its shares from the fluid
+//           particles within r0 of it, with the same weights on the same numbers, so the shares
+//           add up to J.
 //
 // The SBPs' contact mass: what LSM moves when a force lands on the SBP (docs/coupling.md). Its
 // force goes to IBPs d by the shares w_sd (coupling.hpp); a force F on IBP d, split among its n_d

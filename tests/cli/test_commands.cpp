@@ -817,20 +817,28 @@ std::string tiny_scene_with_box(const std::string& name) {
     return scene_file(name, tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
                                           "transform": {"translation": [0.15, 0.1, 0.1]}, "kind": "rigid", "density": 500}])"));
 }
-// The stages `info --json` lists, in order.
-std::vector<std::string> stages_of(const Result& r) {
-    const auto j = nlohmann::json::parse(r.out);
+// `info SCENE --json OPTIONS`, which must succeed, parsed.
+nlohmann::json info_json(const std::string& scene, const std::string& options = "") {
+    const Result r = run("info " + scene + " --json " + options);
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    return nlohmann::json::parse(r.out);
+}
+// The stages it lists, in order.
+std::vector<std::string> stages_of(const nlohmann::json& info) {
     std::vector<std::string> names;
-    for (const auto& s : j["stages"]) names.push_back(s.get<std::string>());
+    for (const auto& s : info["stages"]) names.push_back(s.get<std::string>());
     return names;
+}
+bool runs_stage(const nlohmann::json& info, const std::string& stage) {
+    const std::vector<std::string> names = stages_of(info);
+    return std::find(names.begin(), names.end(), stage) != names.end();
 }
 }  // namespace
 
 TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, when the scene asks for it") {
     const std::string scene = tiny_scene_with_box("coupled.json");
-    const Result on = run("info " + scene + " --json --set coupling.two_way=true");
-    CAPTURE(on.err);
-    REQUIRE(on.code == 0);
+    const nlohmann::json on = info_json(scene, "--set coupling.two_way=true");
     const std::vector<std::string> with = stages_of(on);
     // In the method's order: after PCISPH, before the solids' step.
     const auto pcisph = std::find(with.begin(), with.end(), "pcisph"), coupling = std::find(with.begin(), with.end(), "coupling"),
@@ -838,24 +846,18 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
     REQUIRE(coupling != with.end());
     CHECK(pcisph < coupling);
     CHECK(coupling < lsm);
-    CHECK(nlohmann::json::parse(on.out)["scene"]["coupling"]["two_way"] == true);
+    CHECK(on["scene"]["coupling"]["two_way"] == true);
     CHECK(contains(run("info " + scene + " --set coupling.two_way=true").out, "two-way (coupling.two_way)"));
     CHECK(contains(run("info " + scene).out, "one-way (coupling.two_way false)"));
 
     // Off by default, like every physics switch added after the first release.
-    const Result off = run("info " + scene + " --json");
-    REQUIRE(off.code == 0);
-    CHECK(nlohmann::json::parse(off.out)["scene"]["coupling"]["two_way"] == false);
-    const std::vector<std::string> without = stages_of(off);
-    CHECK(std::find(without.begin(), without.end(), "coupling") == without.end());
-    CHECK(nlohmann::json::parse(off.out)["device_bytes"].get<long>() <
-          nlohmann::json::parse(on.out)["device_bytes"].get<long>());
+    const nlohmann::json off = info_json(scene);
+    CHECK(off["scene"]["coupling"]["two_way"] == false);
+    CHECK(!runs_stage(off, "coupling"));
+    CHECK(off["device_bytes"].get<long>() < on["device_bytes"].get<long>());
 
     // No fluid, nothing to couple: the stage is not run.
-    const Result dry = run("info " + scene + " --json --set fluid_blocks=[] --set coupling.two_way=true");
-    REQUIRE(dry.code == 0);
-    const std::vector<std::string> solids_only = stages_of(dry);
-    CHECK(std::find(solids_only.begin(), solids_only.end(), "coupling") == solids_only.end());
+    CHECK(!runs_stage(info_json(scene, "--set fluid_blocks=[] --set coupling.two_way=true"), "coupling"));
 
     const Result bad = run("info " + scene + " --set coupling.two_ways=true");
     CHECK(bad.code != 0);
@@ -868,15 +870,13 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
 
 TEST_CASE("info: the velocity-position correction against moving objects is a stage after the integration") {
     const std::string scene = tiny_scene_with_box("corrected.json");
-    const Result on = run("info " + scene + " --json --set coupling.two_way=true --set coupling.correction=true");
-    CAPTURE(on.err);
-    REQUIRE(on.code == 0);
+    const nlohmann::json on = info_json(scene, "--set coupling.two_way=true --set coupling.correction=true");
     const std::vector<std::string> with = stages_of(on);
     const auto integrate = std::find(with.begin(), with.end(), "integrate"),
                contact = std::find(with.begin(), with.end(), "solid_contact");
     REQUIRE(contact != with.end());
     CHECK(integrate < contact);
-    const auto resolved = nlohmann::json::parse(on.out)["scene"]["coupling"];
+    const auto resolved = on["scene"]["coupling"];
     CHECK(resolved["correction"] == true);
     CHECK(resolved["slip"] == 1.0);
     CHECK(contains(run("info " + scene + " --set coupling.two_way=true --set coupling.correction=true").out,
@@ -887,11 +887,9 @@ TEST_CASE("info: the velocity-position correction against moving objects is a st
     CHECK(contains(one_way.out, "takes its velocity"));
 
     // Off by default, like every physics switch added after the first release.
-    const Result off = run("info " + scene + " --json --set coupling.two_way=true");
-    REQUIRE(off.code == 0);
-    CHECK(nlohmann::json::parse(off.out)["scene"]["coupling"]["correction"] == false);
-    const std::vector<std::string> without = stages_of(off);
-    CHECK(std::find(without.begin(), without.end(), "solid_contact") == without.end());
+    const nlohmann::json off = info_json(scene, "--set coupling.two_way=true");
+    CHECK(off["scene"]["coupling"]["correction"] == false);
+    CHECK(!runs_stage(off, "solid_contact"));
     CHECK(contains(run("info " + scene).out, "correction against them off (coupling.correction false)"));
 
     const Result slip = run("info " + scene + " --set coupling.correction=true --set coupling.slip=1.5");
@@ -900,4 +898,23 @@ TEST_CASE("info: the velocity-position correction against moving objects is a st
     const Result wrong_type = run("info " + scene + " --set coupling.correction=1");
     CHECK(wrong_type.code != 0);
     CHECK(contains(wrong_type.err, "coupling.correction"));
+}
+
+TEST_CASE("info: interface tension is a stage among the non-pressure forces, when an object has it") {
+    const std::string scene = tiny_scene_with_box("tension.json");
+    const nlohmann::json on = info_json(scene, "--set objects.0.interface_tension=0.2");
+    const std::vector<std::string> with = stages_of(on);
+    const auto tension = std::find(with.begin(), with.end(), "interface_tension"),
+               pcisph = std::find(with.begin(), with.end(), "pcisph");
+    REQUIRE(tension != with.end());
+    CHECK(tension < pcisph);  // it joins the non-pressure acceleration PCISPH starts from
+    CHECK(on["scene"]["objects"][0]["interface_tension"] == 0.2);
+    CHECK(contains(run("info " + scene + " --set objects.0.interface_tension=0.2").out, "interface tension (Eq. 9)"));
+    // Off by default; and without fluid there is nothing to draw.
+    const nlohmann::json off = info_json(scene);
+    CHECK(off["scene"]["objects"][0]["interface_tension"] == 0.0);
+    CHECK(!runs_stage(off, "interface_tension"));
+    CHECK(off["device_bytes"].get<long>() < on["device_bytes"].get<long>());
+    CHECK(!runs_stage(info_json(scene, "--set fluid_blocks=[] --set objects.0.interface_tension=0.2"),
+                      "interface_tension"));
 }
