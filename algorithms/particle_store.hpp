@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "algorithms/state_archive.hpp"
 #include "algorithms/vec3.hpp"
 #include "backend/backend.hpp"
 
@@ -75,6 +76,38 @@ class ParticleStore {
             if (f->life == FieldLife::kPersistent) f->permute(perm, first, scratch_);
     }
 
+    // Checkpoints (state_archive.hpp): every persistent field as block "store.NAME", in the
+    // store's current order, and the two counts. Scratch fields are recomputed by the next step.
+    void save(StateArchive& archive) const {
+        archive.put_value<std::uint64_t>("store.size", size_);
+        archive.put_value<std::uint64_t>("store.moving_count", moving_count_);
+        for (const auto& f : fields_)
+            if (f->life == FieldLife::kPersistent) f->save(archive, "store." + f->name);
+    }
+    // Loads what save() wrote into a store built for the same scene (same size and layout).
+    // `may_be_absent`: fields a step rebuilds when they start from their initial value (the
+    // caller resets them); every other persistent field must be in the archive.
+    void load(const StateArchive& archive, const std::vector<std::string>& may_be_absent = {}) {
+        check_counts(archive);
+        for (auto& f : fields_) {
+            if (f->life != FieldLife::kPersistent) continue;
+            const std::string name = "store." + f->name;
+            bool optional = false;
+            for (const std::string& absent : may_be_absent) optional = optional || absent == f->name;
+            if (optional && !archive.has(name)) continue;
+            f->load(archive, name, size_);
+        }
+    }
+    // Throws InputError unless the archive's store has this one's size and moving count.
+    void check_counts(const StateArchive& archive) const {
+        const auto size = archive.get_value<std::uint64_t>("store.size");
+        const auto moving = archive.get_value<std::uint64_t>("store.moving_count");
+        if (size != size_ || moving != moving_count_)
+            throw InputError("checkpoint: holds " + std::to_string(size) + " particles (" + std::to_string(moving) +
+                             " moving) where the scene builds " + std::to_string(size_) + " (" +
+                             std::to_string(moving_count_) + " moving); it was written for another scene");
+    }
+
     std::size_t bytes() const {
         std::size_t total = scratch_.bytes();
         for (const auto& f : fields_) total += f->bytes();
@@ -96,6 +129,8 @@ class ParticleStore {
         virtual void resize(std::size_t n) = 0;
         virtual std::size_t bytes() const = 0;
         virtual void permute(View<const std::uint32_t> perm, std::size_t first, DeviceArray<unsigned char>& scratch) = 0;
+        virtual void save(StateArchive& archive, const std::string& block) const = 0;
+        virtual void load(const StateArchive& archive, const std::string& block, std::size_t count) = 0;
         std::string name;
         FieldLife life;
     };
@@ -109,6 +144,12 @@ class ParticleStore {
             const std::size_t n = perm.size();
             scratch.resize(n * sizeof(T));
             permute_in_place(array.view().data() + first, perm, reinterpret_cast<T*>(scratch.view().data()));
+        }
+        void save(StateArchive& archive, const std::string& block) const override {
+            archive.put(block, array.to_host());
+        }
+        void load(const StateArchive& archive, const std::string& block, std::size_t count) override {
+            array.upload(archive.get_sized<T>(block, count));
         }
     };
 

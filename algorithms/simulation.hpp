@@ -9,6 +9,7 @@
 
 #include "algorithms/particle_types.hpp"
 #include "algorithms/sph_kernels.hpp"
+#include "algorithms/state_archive.hpp"
 #include "algorithms/vec3.hpp"
 #include "algorithms/wall_contact.hpp"
 
@@ -200,6 +201,12 @@ class Simulation {
     // step, kg m/s, which reaches its IBPs in the next step's coupling (algorithms/solid_contact.hpp);
     // 0 without the correction or two-way coupling. A copy to the host, for tests.
     virtual std::vector<std::array<double, 3>> pending_contact_impulse() const = 0;
+    // Checkpoint and restart (state_archive.hpp): everything the next step reads that the scene
+    // does not give, copied to the host. A simulation built from the same setup, on either
+    // backend, that loads it continues as this one would, bitwise on the same backend. load_state
+    // throws InputError naming what does not fit (another scene, another precision).
+    virtual void save_state(StateArchive& out) const = 0;
+    virtual void load_state(const StateArchive& in) = 0;
 };
 
 }  // namespace mw

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "algorithms/coupling.hpp"
@@ -20,6 +21,7 @@
 #include "algorithms/pcisph.hpp"
 #include "algorithms/solid_contact.hpp"
 #include "algorithms/solid_interpolation.hpp"
+#include "algorithms/state_archive.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -269,6 +271,23 @@ class SolidBodies {
     }
     View<const Vec3> sbp_normals() const { return sbp_normal_.cview(); }
 
+    // Checkpoints (state_archive.hpp): what the solids carry from one step to the next. The
+    // layout (rest shape, regions, links) is rebuilt from the scene; this is the rest: the
+    // regions' rotations (the warm start of the next polar decomposition), the surface normals
+    // (read by the next step's correction before LSM rewrites them), the impulses the correction
+    // left for the next step's coupling, and the per-step arrays that are cheap to keep (so that
+    // no read-before-write of one can make a resumed run differ). A solid particle's slot travels
+    // with the store's fields.
+    void save(StateArchive& archive) const {
+        for_each_state_array(*this, [&](const char* name, const auto& array) { archive.put(name, array.to_host()); });
+    }
+    void load(const StateArchive& archive) {
+        for_each_state_array(*this, [&](const char* name, auto& array) {
+            using T = typename std::decay_t<decltype(array.to_host())>::value_type;
+            array.upload(archive.get_sized<T>(name, array.size()));
+        });
+    }
+
     std::size_t bytes() const {
         return store_of_slot_.bytes() + rest_.bytes() + mass_.bytes() + split_mass_.bytes() + object_.bytes() +
                pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() + displacement_.bytes() +
@@ -345,6 +364,24 @@ class SolidBodies {
     }
 
    private:
+    // Visits each state array of `self` (a SolidBodies, const or not) with its block name.
+    template <class Self, class Visit>
+    static void for_each_state_array(Self& self, Visit&& visit) {
+        visit("solids.rotation", self.rotation_);
+        visit("solids.rotation_matrix", self.rotation_matrix_);
+        visit("solids.mean_rotation", self.mean_rotation_);
+        visit("solids.displacement", self.displacement_);
+        visit("solids.mean_displacement", self.mean_displacement_);
+        visit("solids.region_velocity", self.region_velocity_);
+        visit("solids.region_omega", self.region_omega_);
+        visit("solids.region_acceleration", self.region_acceleration_);
+        visit("solids.region_angular_acceleration", self.region_angular_acceleration_);
+        visit("solids.force", self.force_);
+        visit("solids.reaction", self.reaction_);
+        visit("solids.sbp_normal", self.sbp_normal_);
+        visit("solids.sbp_impulse", self.sbp_impulse_);
+    }
+
     // Per-particle vectors summed in double per object (indexed like SimulationSetup::solids).
     std::vector<std::array<double, 3>> sum_by_object(const std::vector<Vec3>& values,
                                                      const std::vector<std::int32_t>& object) const {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "algorithms/simulation.hpp"
+#include "algorithms/state_archive.hpp"
 
 namespace mw {
 
@@ -59,6 +60,18 @@ class StepSizeControl {
             if (++steps_since_retry_ % kWindow == 0) growth_ = std::min(kGrowthMost, 1 + (growth_ - 1) * 2);
             limit_ = std::min(1e300, limit_ * growth_);
         }
+    }
+
+    // Checkpoints: the limit and its growth shape every later step, so they travel with the state.
+    void save(StateArchive& archive) const {
+        archive.put_value("step_size.limit", limit_);
+        archive.put_value("step_size.growth", growth_);
+        archive.put_value("step_size.steps_since_retry", steps_since_retry_);
+    }
+    void load(const StateArchive& archive) {
+        limit_ = archive.get_value<double>("step_size.limit");
+        growth_ = archive.get_value<double>("step_size.growth");
+        steps_since_retry_ = archive.get_value<long>("step_size.steps_since_retry");
     }
 
    private:

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <numeric>
 #include <string>
@@ -19,6 +20,7 @@
 #include "algorithms/pcisph_delta.hpp"
 #include "algorithms/simulation.hpp"
 #include "algorithms/solid_bodies.hpp"
+#include "algorithms/state_archive.hpp"
 #include "algorithms/step_size.hpp"
 
 MW_BACKEND_BEGIN
@@ -221,6 +223,8 @@ class BackendSimulation final : public Simulation {
     std::vector<std::array<double, 3>> pending_contact_impulse() const override {
         return solids_.object_contact_impulses();
     }
+    void save_state(StateArchive& out) const override;
+    void load_state(const StateArchive& in) override;
 
    private:
     // The PCISPH loop over a neighbourhood (the grid, or this step's lists): predict, density and
@@ -558,6 +562,54 @@ void BackendSimulation<Kernel>::download(HostParticles& out) const {
         out.type[i] = type[k];
         out.object[i] = object[k];
     }
+}
+
+// What the next step reads that the setup does not give: the store's persistent fields (in their
+// current order), the solids' state, the clock and the step-size control. The grid, the lists and
+// the boundary volumes are rebuilt by the next step; the static particles' volumes and cells,
+// computed once from the setup, stay as the constructor made them.
+template <class Kernel>
+void BackendSimulation<Kernel>::save_state(StateArchive& out) const {
+    store_.save(out);
+    solids_.save(out);
+    step_size_.save(out);
+    out.put_value("time", time_);
+    out.put_value("step", step_);
+    out.put_value("last_max_speed", last_max_speed_);
+}
+
+template <class Kernel>
+void BackendSimulation<Kernel>::load_state(const StateArchive& in) {
+    // The static particles were placed by this simulation's setup, and their volumes and cells
+    // computed from those places: a checkpoint whose static particles lie elsewhere belongs to
+    // another scene (or another sampling), and loading it would pair its fluid with the wrong walls.
+    store_.check_counts(in);
+    const std::size_t n = store_.size(), moving = store_.moving_count();
+    const std::vector<Vec3> saved = in.get_sized<Vec3>("store.position", n);
+    const std::vector<Vec3> built = store_.position.to_host();
+    if (std::memcmp(saved.data() + moving, built.data() + moving, (n - moving) * sizeof(Vec3)) != 0)
+        throw InputError("checkpoint: its static boundary particles are not where this scene puts them; it was "
+                         "written for another scene or by another version");
+    // The lists' row counts only size the next layout: a checkpoint from a backend without lists
+    // starts them from 0, as the first step of a run does (one second fill).
+    store_.load(in, {"neighbor_count"});
+    if (neighbor_count_ && !in.has("store.neighbor_count")) neighbor_count_->fill(0);
+    solids_.load(in);
+    step_size_.load(in);
+    time_ = in.get_value<double>("time");
+    step_ = in.get_value<long>("step");
+    last_max_speed_ = in.get_value<double>("last_max_speed");
+    // Counts by type from the loaded types (a particle may have changed type since the start).
+    const std::vector<std::uint8_t> type = store_.type.to_host();
+    counts_ = ParticleCounts{};
+    for (std::uint8_t t : type) {
+        if (t >= kParticleTypeCount) throw InputError("checkpoint: unknown particle type " + std::to_string(t));
+        ++counts_.by_type[t];
+    }
+    inactive_by_design_ = counts_.by_type[kGeometry];
+    report_ = StepReport{};
+    report_.step = step_;
+    report_.time = time_;
 }
 
 // The simulation for the scene's kernel. Each kernel's instantiation has a source file of its own

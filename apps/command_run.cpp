@@ -7,6 +7,7 @@
 #include <exception>
 #include <filesystem>
 
+#include "apps/checkpoint_file.hpp"
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
@@ -87,6 +88,12 @@ std::string density_blowup_message(const StepReport& r, const StatsTable& stats,
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
+
+// Whether two paths name the same existing directory.
+bool same_directory(const std::string& a, const std::string& b) {
+    std::error_code error;
+    return std::filesystem::equivalent(a, b, error) && !error;
+}
 }  // namespace
 
 int command_run(int argc, char** argv) {
@@ -100,6 +107,11 @@ int command_run(int argc, char** argv) {
         ("steps", "run exactly N steps", cxxopts::value<std::string>(), "N")
         ("time", "run to simulated time T seconds (default: the scene's run.end_time)", cxxopts::value<std::string>(), "T")
         ("threads", "OpenMP threads, 1 to 1024 (default: all cores)", cxxopts::value<std::string>(), "N")
+        ("checkpoint", "write DIR/checkpoint.mwc when the run ends or is interrupted")
+        ("checkpoint-every", "write it every N steps as well (implies --checkpoint)", cxxopts::value<std::string>(), "N")
+        ("resume", "continue the run saved in FILE, with its scene (no SCENE, no --set); --time is the "
+                   "simulated time to reach, --steps the steps to add; --out defaults to FILE's directory",
+         cxxopts::value<std::string>(), "FILE")
         ("q,quiet", "print only the final summary line and errors");
     std::vector<std::string> overrides;
     const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
@@ -113,18 +125,43 @@ int command_run(int argc, char** argv) {
         throw InputError("--steps must be at least 1, got " + std::to_string(end_steps));
     const int threads = threads_option(args);
     const bool quiet = flag_option(args, "quiet");
+    const long checkpoint_every = integer_option(args, "checkpoint-every", 0);
+    if (args.count("checkpoint-every") && checkpoint_every < 1)
+        throw InputError("--checkpoint-every must be at least 1, got " + std::to_string(checkpoint_every));
+    const bool checkpoints = flag_option(args, "checkpoint") || checkpoint_every > 0;
     const StopSignals stop_signals;
 
-    Scene scene = scene_from_options(args, overrides);
+    // A resumed run takes everything the simulation is built from out of its checkpoint: the
+    // scene as the first run resolved it (overrides applied, mesh paths absolute), so that the
+    // setup is built exactly as it was.
+    std::unique_ptr<Checkpoint> resume;
+    std::string resume_path;
+    if (args.count("resume")) {
+        resume_path = args["resume"].as<std::string>();
+        if (args.count("scene") || !overrides.empty())
+            throw InputError("--resume continues the checkpoint's own scene: give no SCENE and no --set");
+        resume = std::make_unique<Checkpoint>(read_checkpoint(resume_path));
+    }
+    Scene scene = resume ? resolve_scene(resume->scene, "checkpoint " + resume_path)
+                         : scene_from_options(args, overrides);
     const double end_time = number_option(args, "time", scene.end_time);
     // The same bound as run.end_time: 1e300 s would run for ever.
     if (args.count("time") && !(end_time > 0 && end_time <= 1e6))
         throw InputError("--time must be in (0, 1e6] seconds, got " + format_number(end_time));
+    if (resume && end_steps == 0 && !(resume->time < end_time * (1 - 1e-9)))
+        throw InputError("the checkpoint is at t = " + format_number(resume->time) + " s, already at the end time " +
+                         format_number(end_time) + " s; give a later --time, or --steps");
     const std::string backend = choose_backend(args["backend"].as<std::string>());
     if (threads > 0 && backend != "openmp" && !quiet)
         std::fprintf(stderr, "meltwater: note: --threads applies to the openmp backend only\n");
-    const std::string out_dir =
-        args.count("out") ? args["out"].as<std::string>() : "results/" + (scene.name.empty() ? "run" : scene.name);
+    std::string checkpoint_dir;  // of the resumed checkpoint
+    if (resume) {
+        checkpoint_dir = std::filesystem::path(resume_path).parent_path().string();
+        if (checkpoint_dir.empty()) checkpoint_dir = ".";
+    }
+    const std::string out_dir = args.count("out") ? args["out"].as<std::string>()
+                                : resume          ? checkpoint_dir
+                                                  : "results/" + (scene.name.empty() ? "run" : scene.name);
     if (out_dir.empty()) throw InputError("--out: empty directory name");
 
     check_host_memory(scene, backend, backend == "openmp");
@@ -149,6 +186,7 @@ int command_run(int argc, char** argv) {
         if (scene.writes_vtu() && std::filesystem::exists(frames_path) && !std::filesystem::is_directory(frames_path))
             throw InputError(frames_path + " is a file; the run writes its frames in a directory there");
         sim = create_simulation(setup, backend, threads);
+        if (resume) sim->load_state(resume->state);
     } catch (...) {
         remove_created_directories(created);
         throw;
@@ -158,13 +196,30 @@ int command_run(int argc, char** argv) {
         return report_interrupted_setup();
     }
 
-    remove_earlier_frames(out_dir);
+    // Resumed in its checkpoint's directory, the run continues that directory's frames and
+    // stats.csv from the checkpoint on (what the first run wrote after it goes); elsewhere it
+    // starts them afresh, its frames numbered on from the checkpoint's.
+    const bool continues_directory = resume && same_directory(out_dir, checkpoint_dir);
+    const int first_frame = resume ? static_cast<int>(resume->frame_times.size()) : 0;
+    remove_earlier_frames(out_dir, continues_directory ? first_frame : 0);
+    std::vector<double> frame_times;  // of every frame up to now, for the next checkpoint
+    if (resume) frame_times = resume->frame_times;
     std::unique_ptr<FrameWriter> frames;
     if (scene.writes_vtu()) {
         frames = std::make_unique<FrameWriter>(out_dir);
         frames->set_objects(setup.solids);
+        if (continues_directory) {
+            std::vector<std::pair<double, std::string>> kept;
+            for (int k = 0; k < first_frame; ++k) {
+                char name[64];
+                std::snprintf(name, sizeof name, "particles_%05d.vtu", k);
+                if (std::filesystem::exists(frames->directory() + "/" + name)) kept.emplace_back(frame_times[k], name);
+            }
+            frames->keep_earlier(std::move(kept));
+        }
     }
     StatsTable stats(sim->stage_names());
+    if (continues_directory) stats.keep_earlier_rows(stats_rows_up_to(stats_path, stats.header(), resume->step));
 
     RunSummary summary;
     summary.backend = sim->backend_name();
@@ -177,6 +232,12 @@ int command_run(int argc, char** argv) {
     if (end_steps > 0) std::snprintf(stop, sizeof stop, "steps %ld", end_steps);
     else std::snprintf(stop, sizeof stop, "time %g s", end_time);
     summary.stop_condition = stop;
+    if (resume) {
+        summary.resumed_from = resume_path;
+        summary.resumed_step = resume->step;
+        summary.resumed_time = resume->time;
+        summary.simulated_time = resume->time;
+    }
 
     if (const std::string warning = scene.kernel_warning(); !warning.empty()) {
         std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
@@ -192,27 +253,49 @@ int command_run(int argc, char** argv) {
                      with_thousands(c.total()).c_str(), with_thousands(c.by_type[kFluid]).c_str(),
                      with_thousands(c.total() - c.by_type[kFluid]).c_str(), carved.c_str(), summary.backend.c_str(),
                      summary.device.c_str(), stop, out_dir.c_str());
+        if (resume)
+            std::fprintf(stderr, "meltwater: resuming from %s: step %ld, t = %.6g s (written on %s)\n",
+                         resume_path.c_str(), resume->step, resume->time, resume->backend.c_str());
     }
 
     const auto wall_start = std::chrono::steady_clock::now();
     auto last_stats_write = wall_start;
     double stats_write_seconds = 0;  // how long the last rewrite of stats.csv took
     HostParticles host;
-    int frame_index = 0;
+    int frame_index = first_frame;
     auto write_frame = [&]() {
         if (!frames) return;
         sim->download(host);
         frames->write(frame_index, host, sim->time());
+        frame_times.push_back(sim->time());
         ++frame_index;
+    };
+    const double frame_dt = 1.0 / scene.fps;
+    double next_frame_time = resume ? resume->next_frame_time : frame_dt;
+    // The checkpoint: the state now, with the scene and the frame clock (checkpoint_file.hpp).
+    const std::string checkpoint_path = out_dir + "/" + kCheckpointFileName;
+    long checkpoint_step = -1;
+    auto write_checkpoint_now = [&]() {
+        Checkpoint c;
+        c.scene = scene.resolved;
+        c.backend = summary.backend;
+        c.step = sim->last_report().step;
+        c.time = sim->time();
+        c.frame_times = frame_times;
+        c.next_frame_time = next_frame_time;
+        sim->save_state(c.state);
+        write_checkpoint(checkpoint_path, c);
+        checkpoint_step = c.step;
+        summary.checkpoint = checkpoint_path;
+        summary.checkpoint_step = c.step;
     };
 
     std::exception_ptr failure;
     bool interrupted = false;
     try {
-        write_frame();  // frame 0: the initial state
-        const double frame_dt = 1.0 / scene.fps;
-        double next_frame_time = frame_dt;
-        Progress progress(quiet ? Progress::Mode::kQuiet : Progress::Mode::kAuto, end_steps, end_time);
+        if (!resume) write_frame();  // frame 0: the initial state (a resumed run has its frames)
+        Progress progress(quiet ? Progress::Mode::kQuiet : Progress::Mode::kAuto, end_steps, end_time,
+                          resume ? resume->step : 0, resume ? resume->time : 0.0);
         long steps_done = 0;
         // Stop at the step that reaches end_time (to a relative tolerance, so 0.1 + 0.1 + ... counts).
         while (end_steps > 0 ? steps_done < end_steps : sim->time() < end_time * (1 - 1e-9)) {
@@ -253,6 +336,7 @@ int command_run(int argc, char** argv) {
                 // The next frame time after now (a step longer than 1/fps skips frame times).
                 next_frame_time = (std::floor(r.time / frame_dt * (1 + 1e-9)) + 1) * frame_dt;
             }
+            if (checkpoint_every > 0 && r.step % checkpoint_every == 0) write_checkpoint_now();
             // Keep stats.csv current for a run that dies: every 5 s, or less often once the file
             // is so long that rewriting it would take more than 5% of the run.
             if (seconds_since(last_stats_write) > std::max(5.0, 20 * stats_write_seconds)) {
@@ -267,6 +351,15 @@ int command_run(int argc, char** argv) {
         failure = std::current_exception();
     }
 
+    // A run that ended or was stopped leaves its checkpoint (one that failed does not: its state
+    // is what failed).
+    if (!failure && checkpoints && checkpoint_step != sim->last_report().step) {
+        try {
+            write_checkpoint_now();
+        } catch (...) {
+            failure = std::current_exception();
+        }
+    }
     summary.wall_seconds = seconds_since(wall_start);
     summary.frames = frames ? frames->written() : 0;
     if (failure) {
@@ -329,8 +422,12 @@ int command_run(int argc, char** argv) {
     std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",
                 interrupted ? "interrupted after" : "ran", summary.steps, summary.simulated_time, summary.wall_seconds,
                 stats.median_total_ms(), fluid_figures);
-    std::printf("meltwater: results in %s (%s in frames/, stats.csv, summary.json)\n",
-                ec ? out_dir.c_str() : shown.c_str(), count_of(summary.frames, "frame").c_str());
+    std::printf("meltwater: results in %s (%s in frames/, stats.csv, summary.json%s)\n",
+                ec ? out_dir.c_str() : shown.c_str(), count_of(summary.frames, "frame").c_str(),
+                summary.checkpoint.empty() ? "" : ", checkpoint.mwc");
+    if (!summary.checkpoint.empty() && !quiet)
+        std::fprintf(stderr, "meltwater: checkpoint at step %ld (t = %.6g s); continue with: meltwater run --resume %s "
+                     "--time T\n", summary.checkpoint_step, summary.simulated_time, summary.checkpoint.c_str());
     std::fflush(stdout);
     return interrupted ? 130 : 0;
 }

@@ -10,23 +10,26 @@
 
 namespace mw {
 
-Progress::Progress(Mode mode, long end_steps, double end_time)
+Progress::Progress(Mode mode, long end_steps, double end_time, long start_step, double start_time)
     : quiet_(mode == Mode::kQuiet),
       tty_(::isatty(STDERR_FILENO) != 0),
       end_steps_(end_steps),
       end_time_(end_time),
+      start_step_(start_step),
+      start_time_(start_time),
       start_(std::chrono::steady_clock::now()),
       last_draw_(start_) {}
 
 double Progress::fraction(const StepReport& r) const {
-    const double f = end_steps_ > 0 ? double(r.step) / double(end_steps_) : r.time / end_time_;
+    const double f = end_steps_ > 0 ? double(r.step - start_step_) / double(end_steps_)
+                                    : (r.time - start_time_) / (end_time_ - start_time_);
     return std::clamp(f, 0.0, 1.0);
 }
 
 std::string Progress::line(const StepReport& r, double frac) const {
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double eta = frac > 0 ? elapsed * (1 - frac) / frac : -1;
-    const double end = end_steps_ > 0 ? (frac > 0 ? r.time / frac : 0.0) : end_time_;
+    const double end = end_steps_ > 0 ? (frac > 0 ? start_time_ + (r.time - start_time_) / frac : 0.0) : end_time_;
     const int digits = end >= 0.1 || end == 0 ? 2 : std::min(6, 2 + static_cast<int>(std::ceil(-std::log10(end))));
     char buffer[160];
     std::snprintf(buffer, sizeof buffer, "t=%.*f/%.*f s step %ld | %.1f ms/step | ETA %s", digits, r.time, digits, end,

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <ostream>
 
 #include "apps/atomic_file.hpp"
@@ -25,7 +27,23 @@ std::vector<float> to_floats(const std::vector<Real>& v) { return std::vector<fl
 SceneJson finite_or_null(double v) { return std::isfinite(v) ? SceneJson(v) : SceneJson(nullptr); }
 }  // namespace
 
-void remove_earlier_frames(const std::string& out_dir) {
+namespace {
+// The NNNNN of a frame's file name (particles_NNNNN.vtu, object_NAME_NNNNN.obj), or -1.
+int frame_number(const std::string& name, const std::string& extension) {
+    const std::size_t digits = 5;
+    if (name.size() < digits + extension.size() + 1) return -1;
+    const std::size_t first = name.size() - extension.size() - digits;
+    if (name[first - 1] != '_') return -1;
+    int number = 0;
+    for (std::size_t k = first; k < first + digits; ++k) {
+        if (name[k] < '0' || name[k] > '9') return -1;
+        number = number * 10 + (name[k] - '0');
+    }
+    return number;
+}
+}  // namespace
+
+void remove_earlier_frames(const std::string& out_dir, int keep_below) {
     const std::string frames_dir = out_dir + "/frames";
     std::error_code error;
     if (std::filesystem::is_directory(frames_dir, error)) {
@@ -35,16 +53,19 @@ void remove_earlier_frames(const std::string& out_dir) {
             const std::size_t tmp = name.find(".tmp.");
             const std::string frame_name = tmp == std::string::npos ? name : name.substr(0, tmp);
             const std::string extension = std::filesystem::path(frame_name).extension().string();
-            if ((frame_name.rfind("particles_", 0) == 0 && extension == ".vtu") || frame_name == "particles.pvd" ||
-                (frame_name.rfind("object_", 0) == 0 && extension == ".obj"))
-                std::filesystem::remove(entry.path(), error);
+            const bool frame = (frame_name.rfind("particles_", 0) == 0 && extension == ".vtu") ||
+                               (frame_name.rfind("object_", 0) == 0 && extension == ".obj");
+            const bool kept = frame && tmp == std::string::npos && frame_number(frame_name, extension) >= 0 &&
+                              frame_number(frame_name, extension) < keep_below;
+            if ((frame && !kept) || frame_name == "particles.pvd") std::filesystem::remove(entry.path(), error);
         }
         std::filesystem::remove(frames_dir, error);  // only if now empty: a user's own files stay
     }
     // The same for temporaries of stats.csv and summary.json in DIR itself.
     for (const auto& entry : std::filesystem::directory_iterator(out_dir, error)) {
         const std::string name = entry.path().filename().string();
-        if (name.rfind("stats.csv.tmp.", 0) == 0 || name.rfind("summary.json.tmp.", 0) == 0)
+        if (name.rfind("stats.csv.tmp.", 0) == 0 || name.rfind("summary.json.tmp.", 0) == 0 ||
+            name.rfind("checkpoint.mwc.tmp.", 0) == 0)
             std::filesystem::remove(entry.path(), error);
     }
 }
@@ -67,6 +88,16 @@ std::string FrameWriter::write(int index, const HostParticles& p, double time) {
     write_objects(index, p);
     ++written_;
     collection_.emplace_back(time, name);
+    write_collection();
+    return path;
+}
+
+void FrameWriter::keep_earlier(std::vector<std::pair<double, std::string>> frames) {
+    collection_ = std::move(frames);
+    write_collection();
+}
+
+void FrameWriter::write_collection() const {
     write_file_atomically(frames_dir_ + "/particles.pvd", [&](std::ostream& out) {
         out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
         char line[160];
@@ -76,7 +107,6 @@ std::string FrameWriter::write(int index, const HostParticles& p, double time) {
         }
         out << "  </Collection>\n</VTKFile>\n";
     });
-    return path;
 }
 
 void FrameWriter::write_objects(int index, const HostParticles& p) const {
@@ -137,7 +167,21 @@ std::string StatsTable::header() const {
 }
 
 void StatsTable::write(const std::string& path) const {
-    write_file_atomically(path, [&](std::ostream& out) { out << header() << '\n' << csv_rows_; });
+    write_file_atomically(path, [&](std::ostream& out) { out << header() << '\n' << earlier_rows_ << csv_rows_; });
+}
+
+std::string stats_rows_up_to(const std::string& path, const std::string& header, long last_step) {
+    std::ifstream in(path);
+    std::string line, rows;
+    if (!in || !std::getline(in, line) || line != header) return "";
+    while (std::getline(in, line)) {
+        // A row starts with its step; a damaged line ends the table there.
+        char* end = nullptr;
+        const long step = std::strtol(line.c_str(), &end, 10);
+        if (end == line.c_str() || *end != ',' || step > last_step) break;
+        rows += line + '\n';
+    }
+    return rows;
 }
 
 std::vector<double> StatsTable::median_stage_ms() const {
@@ -218,6 +262,10 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;
     j["frames"] = run.frames;
     j["warnings"] = run.warnings;
+    if (!run.resumed_from.empty())
+        j["resumed_from"] = {{"checkpoint", run.resumed_from}, {"step", run.resumed_step},
+                             {"time", finite_or_null(run.resumed_time)}};
+    if (!run.checkpoint.empty()) j["checkpoint"] = {{"path", run.checkpoint}, {"step", run.checkpoint_step}};
     j["scene"] = scene.resolved;
     // A path given on the command line may hold bytes that are not UTF-8: replaced, never fatal.
     const std::string text = j.dump(2, ' ', false, SceneJson::error_handler_t::replace) + "\n";

@@ -16,8 +16,14 @@ namespace mw {
 // Frames of an earlier run into the same directory would mix with this run's, or sit next to a
 // summary that says it wrote none: remove them (particles_*.vtu, particles.pvd, object_*.obj,
 // and the temporaries of a killed run), and frames/ itself when that leaves it empty. Run before
-// every run, with or without frames.
-void remove_earlier_frames(const std::string& out_dir);
+// every run, with or without frames. A run resumed in its checkpoint's directory keeps the
+// frames numbered below `keep_below` (those written before the checkpoint).
+void remove_earlier_frames(const std::string& out_dir, int keep_below = 0);
+
+// The rows of an earlier stats.csv at `path` up to and including step `last_step`, when its
+// header is `header` ("" otherwise: no file, or another set of columns). A run resumed in its
+// checkpoint's directory continues the table from there.
+std::string stats_rows_up_to(const std::string& path, const std::string& header, long last_step);
 
 // Writes frames/particles_NNNNN.vtu (and the objects' meshes, once set_objects() was called).
 class FrameWriter {
@@ -28,11 +34,15 @@ class FrameWriter {
     // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView
     // collection listing every frame with its time. Returns the frame's path.
     std::string write(int index, const HostParticles& particles, double time);
-    int written() const { return written_; }
+    // A resumed run: the frames already in the directory (time, file name), which particles.pvd
+    // keeps listing before the new ones; rewrites particles.pvd at once.
+    void keep_earlier(std::vector<std::pair<double, std::string>> frames);
+    int written() const { return written_; }  // by this run
     const std::string& directory() const { return frames_dir_; }
 
    private:
     void write_objects(int index, const HostParticles& particles) const;
+    void write_collection() const;
     std::string frames_dir_;
     std::vector<SolidSetup> objects_;
     int written_ = 0;
@@ -45,6 +55,9 @@ class StatsTable {
    public:
     explicit StatsTable(std::vector<std::string> stage_names);
     void add(const StepReport& report);
+    // Rows of the run this one resumes (stats_rows_up_to), written before this run's; the figures
+    // below cover this run's rows only.
+    void keep_earlier_rows(std::string rows) { earlier_rows_ = std::move(rows); }
     std::string header() const;
     void write(const std::string& path) const;
 
@@ -65,6 +78,7 @@ class StatsTable {
 
    private:
     std::vector<std::string> stages_;
+    std::string earlier_rows_;                   // a resumed run's rows from before its checkpoint
     std::string csv_rows_;                       // every row so far, as written to stats.csv
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]
     std::vector<double> total_ms_, error_avg_, error_max_;
@@ -87,6 +101,13 @@ struct RunSummary {
     int frames = 0;
     std::string stop_condition;  // "steps N" or "time T s"
     std::vector<std::string> warnings;  // about the scene, given before the run (Scene::kernel_warning)
+    // A resumed run: the checkpoint it started from, and that checkpoint's step and time.
+    std::string resumed_from;
+    long resumed_step = 0;
+    double resumed_time = 0;
+    // The last checkpoint this run wrote ("" if none), and its step.
+    std::string checkpoint;
+    long checkpoint_step = 0;
 };
 
 void write_summary(const std::string& path, const RunSummary& summary, const StatsTable& stats, const Scene& scene);

@@ -9,6 +9,10 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
 
 #include "tests/scratch_dir.hpp"
 
@@ -73,6 +77,23 @@ inline std::string scene_file(const std::string& name, const std::string& text) 
     const std::string path = scratch_dir() + "/" + name;
     write_text(path, text);
     return path;
+}
+
+// A fresh (removed) output directory `name` in the scratch directory.
+inline std::string out_dir(const std::string& name) {
+    const std::string d = scratch_dir() + "/" + name;
+    std::filesystem::remove_all(d);
+    return d;
+}
+inline nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path)); }
+
+// One line, naming each of `parts`, and exit status `code`.
+inline void check_rejected(const Result& r, const std::vector<std::string>& parts, int code = 2) {
+    CAPTURE(r.err);
+    CHECK(r.code == code);
+    CHECK(contains(r.err, "meltwater: "));
+    CHECK(count_lines(r.err) == 1);
+    for (const auto& p : parts) CHECK(contains(r.err, p));
 }
 
 }  // namespace cli_test

@@ -23,21 +23,6 @@ std::string tiny() {
     static const std::string path = scene_file("tiny.json", tiny_scene_text());
     return path;
 }
-std::string out_dir(const std::string& name) {
-    const std::string d = scratch_dir() + "/" + name;
-    fs::remove_all(d);
-    return d;
-}
-nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path)); }
-
-// One line, naming `part`, non-zero exit.
-void check_rejected(const Result& r, const std::vector<std::string>& parts, int code = 2) {
-    CAPTURE(r.err);
-    CHECK(r.code == code);
-    CHECK(contains(r.err, "meltwater: "));
-    CHECK(count_lines(r.err) == 1);
-    for (const auto& p : parts) CHECK(contains(r.err, p));
-}
 }  // namespace
 
 TEST_CASE("bad input: files") {
