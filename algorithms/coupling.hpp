@@ -8,7 +8,8 @@
 //      friction (Eq. 8, when on)           F_b = -Σ_i m (μ_w/ρ0) V_b ∇²W(x_i - x_b) (v_b - v_i)
 //      interface tension (Eq. 9, SBPs)     F_s = Σ_i η_s m ρ0 V_s W(x_is) x_is / |x_is|
 //                                          (interface_tension.hpp; positions of the step's start)
-//    with the last PCISPH iteration's predicted positions x* and pressures, so that the pair's
+//    with the last PCISPH iteration's predicted positions x* (the fluid's, and the solids' where
+//    PCISPH predicts them) and pressures, so that the pair's
 //    two forces cancel to rounding: the fluid and the solids together conserve momentum. With the
 //    velocity–position correction against solids on, an SBP's reaction also carries the impulse
 //    the correction gave it at the end of the last step (solid_contact.hpp), as J / Δt.
@@ -103,6 +104,8 @@ struct FluidPairs {
     GridView grid;
     std::size_t fluid_end = 0, solid_end = 0;  // the moving solids' boundary particles: [fluid_end, solid_end)
     Real list_radius2 = 0;
+    // Where PCISPH met the solids' particles (pcisph.hpp): the reaction meets them there too.
+    SolidLookahead lookahead;
 };
 
 template <class Kernel>
@@ -125,7 +128,7 @@ void fluid_reaction_on_solids(const FluidPairs pairs, const CouplingData d, View
         pairs.grid.for_each_fluid(xb, [&](std::uint32_t i) {
             const Vec3 xi = position[i];
             const Real paired = lists ? (norm2(xi - xb) < pairs.list_radius2 ? Real(1) : Real(0)) : Real(1);
-            const Vec3 r = predicted[i] - xb;
+            const Vec3 r = predicted[i] - pairs.lookahead.place(b, xb);
             pressure_sum += (paired * pressure_term[i]) * c.kernel.grad_W_r2(r, norm2(r));
             if (friction) friction_sum += c.kernel.laplacian_visc_r2(norm2(xi - xb)) * (vb - velocity[i]);
             if (eta > Real(0)) {

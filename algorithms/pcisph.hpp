@@ -117,21 +117,39 @@ inline void predict_positions(std::size_t fluid_count, View<const Vec3> position
     });
 }
 
+// Where PCISPH meets the moving solids' boundary particles (store indices below `end`, above the
+// fluid): where they will be at the end of the step if they keep their velocity, x_b + Δt v_b,
+// not where they start it. LSM moves a solid after PCISPH, so a solid entering the fluid at the
+// CFL step (0.4 r0 a step) would otherwise land inside fluid that was solved against where it
+// had been: a box thrown flat onto a resting pool at 2.5 m/s left a fluid particle 0.59 r0 under
+// its surface particles, and PCISPH diverged at every halving of the next step
+// (docs/coupling.md, "Solids met where they will be"). Static boundary particles stay put.
+struct SolidLookahead {
+    const Vec3* velocity = nullptr;  // the store's; null: every boundary particle where it is
+    std::size_t end = 0;             // the moving solids' boundary particles end here
+    Real dt = 0;
+    MW_INLINE Vec3 place(std::uint32_t b, Vec3 xb) const {
+        return velocity && b < end ? xb + dt * velocity[b] : xb;
+    }
+};
+
 // Predicted density from fluid (at predicted positions) and boundary particles, then
 // p_i += δ (ρ*_i - ρ0), clamped at 0 (free-surface particle deficiency), and p_i/ρ_i².
 // The first iteration of a step starts from p = 0 (so no separate pass clears the pressure).
+// Moving solids' boundary particles are met where `lookahead` puts them, static ones where they are.
 template <class Neighbors, class Kernel>
 void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
-                                  View<const Vec3> position, View<const Real> boundary_volume, View<Real> density,
-                                  View<Real> pressure, View<Real> pressure_term, FluidConstants<Kernel> c,
-                                  Real delta, bool first_iteration) {
+                                  View<const Vec3> position, SolidLookahead lookahead,
+                                  View<const Real> boundary_volume, View<Real> density, View<Real> pressure,
+                                  View<Real> pressure_term, FluidConstants<Kernel> c, Real delta,
+                                  bool first_iteration) {
     parallel_for("pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         const Real fluid_sum = neighbors.sum_fluid(i, position[i], [&](std::uint32_t j) {
             return c.kernel.W_r2(norm2(xi - predicted[j]));
         });
         const Real boundary_sum = neighbors.sum_boundary(i, position[i], [&](std::uint32_t b) {
-            return boundary_volume[b] * c.kernel.W_r2(norm2(xi - position[b]));
+            return boundary_volume[b] * c.kernel.W_r2(norm2(xi - lookahead.place(b, position[b])));
         });
         const Real rho = c.mass * fluid_sum + c.rest_density * boundary_sum;
         density[i] = rho;
@@ -155,7 +173,7 @@ inline DensityError density_error(std::size_t fluid_count, View<const Real> dens
 // a_p,i = -m Σ_j (p_i/ρ_i² + p_j/ρ_j²) ∇W(x*_ij) - Σ_b ψ_b (p_i/ρ_i²) ∇W(x*_i - x_b).
 template <class Neighbors, class Kernel>
 void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
-                           View<const Vec3> position, View<const Real> boundary_volume,
+                           View<const Vec3> position, SolidLookahead lookahead, View<const Real> boundary_volume,
                            View<const Real> pressure_term, View<Vec3> pressure_acc, FluidConstants<Kernel> c) {
     parallel_for("pcisph_pressure_force", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
@@ -166,7 +184,7 @@ void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<co
             return (pi_rho2 + pressure_term[j]) * c.kernel.grad_W_r2(d, norm2(d));
         });
         const Vec3 boundary_sum = neighbors.sum_boundary(i, position[i], [&](std::uint32_t b) {
-            const Vec3 d = xi - position[b];
+            const Vec3 d = xi - lookahead.place(b, position[b]);
             return boundary_volume[b] * c.kernel.grad_W_r2(d, norm2(d));
         });
         pressure_acc[i] = -(c.mass * fluid_sum + (c.rest_density * pi_rho2) * boundary_sum);

@@ -84,6 +84,9 @@ struct SimulationParams {
     // 1 free slip).
     bool solid_correction = false;
     Real solid_slip = 1;
+    // PCISPH solves against the moving solids' boundary particles where they will be at the end
+    // of the step (x_b + Δt v_b), not where they start it (pcisph.hpp, SolidLookahead).
+    bool solid_prediction = true;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

@@ -106,6 +106,12 @@ class BackendSimulation final : public Simulation {
             timers_.start(kPcisph);
             for (;;) {
                 const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
+                // PCISPH meets the moving solids where this try's step will take them.
+                if (predicts_solids_) {
+                    lookahead_.velocity = store_.velocity.cview().data();
+                    lookahead_.end = ranges_.solid_end;
+                    lookahead_.dt = dt;
+                }
                 int tried = 0;
                 error = use_lists_ ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, solid_surface, delta,
                                                        dt, tried, outcome)
@@ -132,6 +138,7 @@ class BackendSimulation final : public Simulation {
             pairs.fluid_end = ranges_.fluid_end;
             pairs.solid_end = ranges_.solid_end;
             pairs.list_radius2 = use_lists_ ? fluid_.kernel.h * fluid_.kernel.h : Real(0);
+            pairs.lookahead = lookahead_;
             coupling.inverse_dt = Real(1) / dt;
             fluid_reaction_on_solids(pairs, coupling, store_.position.cview(), store_.velocity.cview(),
                                      predicted_.cview(), boundary_volume_.cview(), pressure_term_.cview(), fluid_,
@@ -255,10 +262,10 @@ class BackendSimulation final : public Simulation {
             predict_positions(fluid_count, store_.position.cview(), store_.velocity.cview(), nonpressure,
                               first ? nullptr : pressure_acc_.view().data(), predicted_.view(), fluid_.gravity, dt,
                               wall_contact_, solid_surface);
-            predict_density_and_pressure(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
+            predict_density_and_pressure(neighbors, fluid_count, predicted_.cview(), store_.position.cview(), lookahead_,
                                          boundary_volume_.cview(), store_.density.view(), store_.pressure.view(),
                                          pressure_term_.view(), fluid_, delta, first);
-            pressure_acceleration(neighbors, fluid_count, predicted_.cview(), store_.position.cview(),
+            pressure_acceleration(neighbors, fluid_count, predicted_.cview(), store_.position.cview(), lookahead_,
                                   boundary_volume_.cview(), pressure_term_.cview(), pressure_acc_.view(), fluid_);
             ++iterations;
             // The error is a reduction read back by the host (a synchronisation on a GPU), so it is
@@ -364,6 +371,9 @@ class BackendSimulation final : public Simulation {
     bool has_solid_volumes_ = false;  // moving solids and fluid: boundary volumes every step
     bool has_coupling_ = false;       // ... and two-way coupling: the fluid's forces act on them
     bool has_solid_contact_ = false;  // ... and the velocity–position correction against them
+    // ... and PCISPH meets them where they will be (pcisph.hpp, SolidLookahead), this try's.
+    bool predicts_solids_ = false;
+    SolidLookahead lookahead_;
     DeviceArray<Vec3> impulse_per_weight_;  // the correction's, per fluid particle (two-way only)
     DeviceArray<std::uint8_t> fluid_near_solid_;  // its gathers' mask, per fluid particle (virtual_boundary.hpp)
     Real contact_band_ = 0;                 // its band c, m
@@ -484,6 +494,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     has_coupling_ = has_solid_volumes_ && solids_.coupled();
     has_tension_ = has_solid_volumes_ && solids_.has_tension();
     has_solid_contact_ = has_solid_volumes_ && params_.solid_correction;
+    predicts_solids_ = has_solid_volumes_ && params_.solid_prediction;
     contact_band_ = static_cast<Real>(kMovingSolidContact * fp.spacing);
     if (!(params_.solid_slip >= 0 && params_.solid_slip <= 1))
         throw InputError("simulation setup: the solids' slip factor must be in [0, 1]");
