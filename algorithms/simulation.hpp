@@ -85,8 +85,10 @@ struct SimulationParams {
     bool solid_correction = false;
     Real solid_slip = 1;
     // PCISPH solves against the moving solids' boundary particles where they will be at the end
-    // of the step (x_b + Δt v_b), not where they start it (pcisph.hpp, SolidLookahead).
-    bool solid_prediction = true;
+    // of the step (x_b + Δt v_b), not where they start it (pcisph.hpp, SolidLookahead). Off unless
+    // asked for (the scenes' coupling.predict_solids): it cures a blow-up where a solid enters
+    // the fluid at the CFL step, but livens the fluid resting by soft objects (docs/coupling.md).
+    bool solid_prediction = false;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

@@ -114,8 +114,14 @@ class SolidBodies {
         sbp_normal_.upload(L.sbp_normal);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
-        sbp_object_.resize(sbp_count_);
-        for (std::size_t k = 0; k < sbp_count_; ++k) sbp_object_[k] = setup.object[L.scene_index[ibp_count_ + k]];
+        // Each SBP's object, as an index into setup.solids (the layout's order: moving objects in
+        // turn, each one's SBPs together). Not setup.object, which numbers the static boxes first:
+        // with static boxes in a scene, an SBP's entry there is past the end of setup.solids.
+        sbp_object_.clear();
+        for (std::size_t o = 0; o < setup.solids.size(); ++o)
+            if (setup.solids[o].kind != SolidKind::kStatic)
+                sbp_object_.insert(sbp_object_.end(), setup.solids[o].sbp.size(), std::int32_t(o));
+        if (sbp_object_.size() != sbp_count_) throw InputError("simulation setup: the SBPs' count differs from the layout's");
         // Interface tension (interface_tension.hpp): each SBP's η, its object's; none stored when
         // no object has any.
         std::vector<Real> sbp_eta(sbp_count_, Real(0));
