@@ -118,18 +118,27 @@ inline void predict_positions(std::size_t fluid_count, View<const Vec3> position
 }
 
 // Where PCISPH meets the moving solids' boundary particles (store indices below `end`, above the
-// fluid): where they will be at the end of the step if they keep their velocity, x_b + Δt v_b,
-// not where they start it. LSM moves a solid after PCISPH, so a solid entering the fluid at the
-// CFL step (0.4 r0 a step) would otherwise land inside fluid that was solved against where it
-// had been: a box thrown flat onto a resting pool at 2.5 m/s left a fluid particle 0.59 r0 under
-// its surface particles, and PCISPH diverged at every halving of the next step
-// (docs/coupling.md, "Solids met where they will be"). Static boundary particles stay put.
+// fluid) under coupling.predict_solids: where they will be at the end of the step, not where they
+// start it. LSM moves a solid after PCISPH, so a solid entering the fluid at the CFL step (0.4 r0
+// a step) would otherwise land inside fluid that was solved against where it had been: a box
+// thrown flat onto a resting pool at 2.5 m/s left a fluid particle 0.59 r0 under its surface
+// particles, and PCISPH diverged at every halving of the next step. A rigid object's particle is
+// taken Δt ahead at its own velocity (rotation included); a soft object's at its object's mean
+// velocity, since its own carries the object's vibration, which the fluid's pressure would answer
+// (the floating jelly's pool ran three times as fast; docs/coupling.md, "Solids met where they
+// will be"). Static boundary particles stay put.
 struct SolidLookahead {
-    const Vec3* velocity = nullptr;  // the store's; null: every boundary particle where it is
-    std::size_t end = 0;             // the moving solids' boundary particles end here
+    const Vec3* velocity = nullptr;            // the store's; null: every boundary particle where it is
+    const Vec3* object_velocity = nullptr;     // per object, its mean velocity
+    const std::uint8_t* object_rigid = nullptr;  // per object, 1 if rigid
+    const std::int32_t* solid_slot = nullptr;  // the store's solid_slot field (solid_bodies.hpp)
+    const std::int32_t* slot_object = nullptr; // per IBP and SBP slot, its object
+    std::size_t end = 0;                       // the moving solids' boundary particles end here
     Real dt = 0;
     MW_INLINE Vec3 place(std::uint32_t b, Vec3 xb) const {
-        return velocity && b < end ? xb + dt * velocity[b] : xb;
+        if (!velocity || b >= end) return xb;
+        const std::int32_t o = slot_object[solid_slot[b]];
+        return xb + dt * (object_rigid[o] ? velocity[b] : object_velocity[o]);
     }
 };
 

@@ -85,10 +85,10 @@ struct SimulationParams {
     bool solid_correction = false;
     Real solid_slip = 1;
     // PCISPH solves against the moving solids' boundary particles where they will be at the end
-    // of the step (x_b + Δt v_b), not where they start it (pcisph.hpp, SolidLookahead). Off unless
-    // asked for (the scenes' coupling.predict_solids): it cures a blow-up where a solid enters
-    // the fluid at the CFL step, but livens the fluid resting by soft objects (docs/coupling.md).
-    bool solid_prediction = false;
+    // of the step, not where they start it (pcisph.hpp, SolidLookahead; the scenes'
+    // coupling.predict_solids). On, unlike the switches above: it mends the step's order (a solid
+    // entering the fluid at the CFL step blew the pool up) at little cost at rest (docs/coupling.md).
+    bool solid_prediction = true;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

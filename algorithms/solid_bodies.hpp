@@ -122,6 +122,20 @@ class SolidBodies {
             if (setup.solids[o].kind != SolidKind::kStatic)
                 sbp_object_.insert(sbp_object_.end(), setup.solids[o].sbp.size(), std::int32_t(o));
         if (sbp_object_.size() != sbp_count_) throw InputError("simulation setup: the SBPs' count differs from the layout's");
+        // The lookahead's (pcisph.hpp, SolidLookahead): each IBP's and SBP's object by slot, each
+        // object's IBP slots (contiguous, objects in order; static objects: none) for its mean
+        // velocity, and whether it is rigid.
+        std::vector<std::int32_t> slot_object(L.ibp_object.begin(), L.ibp_object.end());
+        slot_object.insert(slot_object.end(), sbp_object_.begin(), sbp_object_.end());
+        slot_object_.upload(slot_object);
+        std::vector<std::uint32_t> ibp_begin(object_count_ + 1, 0);
+        for (std::size_t s = 0; s < ibp_count_; ++s) ++ibp_begin[std::size_t(L.ibp_object[s]) + 1];
+        for (std::size_t o = 0; o < object_count_; ++o) ibp_begin[o + 1] += ibp_begin[o];
+        object_ibp_begin_.upload(ibp_begin);
+        std::vector<std::uint8_t> rigid(object_count_, 0);
+        for (std::size_t o = 0; o < object_count_; ++o) rigid[o] = setup.solids[o].kind == SolidKind::kRigid;
+        object_rigid_.upload(rigid);
+        object_velocity_.assign(object_count_, Vec3{0, 0, 0});
         // Interface tension (interface_tension.hpp): each SBP's η, its object's; none stored when
         // no object has any.
         std::vector<Real> sbp_eta(sbp_count_, Real(0));
@@ -178,6 +192,35 @@ class SolidBodies {
         interpolate_geometry(g, dt);
         interpolate_surface(g);
         return summary(store);
+    }
+
+    // Where PCISPH meets the moving solids this step (pcisph.hpp, SolidLookahead): each soft
+    // object's mean velocity (its momentum over its mass; one thread per object sums its IBPs in
+    // slot order, deterministic), and the way from a store index to its object. The slot map must
+    // be current.
+    SolidLookahead lookahead(const ParticleStore& store, std::size_t solid_end) {
+        const Vec3* velocity = store.velocity.cview().data();
+        const std::uint32_t* store_of_slot = store_of_slot_.view().data();
+        const std::uint32_t* begin = object_ibp_begin_.view().data();
+        const Real* mass = mass_.view().data();
+        Vec3* mean = object_velocity_.view().data();
+        parallel_for("solid_object_velocity", object_count_, [=] MW_HD(std::size_t o) {
+            Vec3 momentum{0, 0, 0};
+            Real total = 0;
+            for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
+                momentum += mass[s] * velocity[store_of_slot[s]];
+                total += mass[s];
+            }
+            mean[o] = total > Real(0) ? momentum / total : Vec3{0, 0, 0};
+        });
+        SolidLookahead l;
+        l.velocity = velocity;
+        l.object_velocity = mean;
+        l.object_rigid = object_rigid_.view().data();
+        l.solid_slot = solid_slot_->cview().data();
+        l.slot_object = slot_object_.view().data();
+        l.end = solid_end;
+        return l;
     }
 
     // The IBPs' kinetic energy, top speed and first non-finite slot (a reduction read back).
@@ -305,7 +348,8 @@ class SolidBodies {
                region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
-               share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes();
+               share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
+               slot_object_.bytes() + object_ibp_begin_.bytes() + object_rigid_.bytes() + object_velocity_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -438,6 +482,10 @@ class SolidBodies {
     DeviceArray<Real> sbp_inverse_mass_;
     DeviceArray<Vec3> sbp_impulse_;
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
+    DeviceArray<std::int32_t> slot_object_;        // per IBP and SBP slot, its object
+    DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
+    DeviceArray<std::uint8_t> object_rigid_;       // per object, 1 if rigid
+    DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
 };
 

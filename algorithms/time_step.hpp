@@ -83,6 +83,8 @@ class BackendSimulation final : public Simulation {
             timers_.stop(kInterfaceTension);
         }
         const Vec3* nonpressure = has_viscosity_ || has_tension_ ? nonpressure_.view().data() : nullptr;
+        //    Where PCISPH will meet the moving solids (pcisph.hpp, SolidLookahead).
+        if (predicts_solids_) lookahead_ = solids_.lookahead(store_, ranges_.solid_end);
         // The moving solids' surface for the velocity–position correction (its position rule in
         // PCISPH, then the whole rule after the integration); none without it.
         SolidSurface solid_surface;
@@ -107,11 +109,7 @@ class BackendSimulation final : public Simulation {
             for (;;) {
                 const Real delta = static_cast<Real>(delta_times_dt2_ / (double(dt) * double(dt)));
                 // PCISPH meets the moving solids where this try's step will take them.
-                if (predicts_solids_) {
-                    lookahead_.velocity = store_.velocity.cview().data();
-                    lookahead_.end = ranges_.solid_end;
-                    lookahead_.dt = dt;
-                }
+                if (predicts_solids_) lookahead_.dt = dt;
                 int tried = 0;
                 error = use_lists_ ? pcisph_iterations(lists_.view(), fluid_count, nonpressure, solid_surface, delta,
                                                        dt, tried, outcome)

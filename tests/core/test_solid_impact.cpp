@@ -1,9 +1,9 @@
-// A solid thrown flat onto a resting pool at the CFL step. With the solids' lookahead
-// (coupling.predict_solids; pcisph.hpp, SolidLookahead) PCISPH solves against where the solid's
-// boundary particles will be at the end of the step. Without it (the default, for the price it
-// has at rest: docs/coupling.md) the box's face lands up to 0.4 r0 inside the top fluid layer
-// each step, and at one entry phase a fluid particle was left 0.59 r0 under its surface
-// particles: PCISPH diverged at every halving of the step and the pool blew up (fluid at 400 m/s).
+// A solid thrown flat onto a resting pool at the CFL step. PCISPH solves against where the
+// solid's boundary particles will be at the end of the step (coupling.predict_solids, on by
+// default; pcisph.hpp, SolidLookahead). Solved against where they started it, the box's face
+// landed up to 0.4 r0 inside the top fluid layer each step, and at one entry phase a fluid
+// particle was left 0.59 r0 under its surface particles: PCISPH diverged at every halving of the
+// step and the pool blew up (fluid at 400 m/s).
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -60,7 +60,7 @@ Impact throw_box(SolidKind kind, double density, double drop, bool correction, b
 }
 }  // namespace
 
-TEST_CASE("with the solids' lookahead a box thrown flat onto a pool at the CFL step enters it calmly, at every entry phase") {
+TEST_CASE("a box thrown flat onto a pool at the CFL step enters it calmly, at every entry phase") {
     // Drops of 0.07 to 0.09 m reach the surface at about 2.5 m/s (0.4 r0 a step) at phases a step
     // apart; 0.07 m is the one that blew up.
     for (const SolidKind kind : {SolidKind::kRigid, SolidKind::kElastic}) {
@@ -82,8 +82,7 @@ TEST_CASE("with the solids' lookahead a box thrown flat onto a pool at the CFL s
 }
 
 TEST_CASE("solved against the solids' starting positions, the same throw blows up the pool") {
-    // The default. The test above would pass without the lookahead at most phases; this is the one
-    // it fails.
+    // The test above would pass without the lookahead at most phases; this is the one it fails.
     const Impact rigid = throw_box(SolidKind::kRigid, 500, 0.07, false, false);
     CHECK(rigid.diverged);
     CHECK(rigid.top_fluid_speed > 50);
