@@ -171,6 +171,13 @@ int command_info(int argc, char** argv) {
                         double(scene.params.solid_slip));
         else
             std::printf("            velocity-position correction against them off (coupling.correction false)\n");
+        if (scene.params.solid_prediction)
+            std::printf("            PCISPH meets them where they will be at the end of the step "
+                        "(coupling.predict_solids): rigid ones at their particles' velocity, soft ones at "
+                        "their mean velocity\n");
+        else
+            std::printf("            PCISPH meets them where they start the step (coupling.predict_solids false): "
+                        "one entering the fluid fast can blow it up\n");
         long with_tension = 0;
         for (const SceneObject& o : scene.objects) with_tension += o.interface_tension > 0 ? 1 : 0;
         if (with_tension)
