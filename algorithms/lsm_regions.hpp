@@ -43,6 +43,7 @@ struct LsmObjectParams {
     Real damping_rate = 0;  // 1/s
     Real friction = 0;      // wall friction
     Real margin = 0;        // IBPs stay this far inside the domain walls
+    std::uint8_t rigid = 0; // 1 for a rigid object (one region), 0 for an elastic one
 };
 
 struct SbpLink {
@@ -247,6 +248,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         P.damping_rate = s.damping;
         P.friction = s.wall_friction;
         P.margin = Real(0.5) * s.spacing;
+        P.rigid = s.kind == SolidKind::kRigid ? 1 : 0;
         const Real mass = s.density * s.spacing * s.spacing * s.spacing;
         const std::size_t base = ibp_base[o];
         for (std::size_t k = 0; k < s.ibp.size(); ++k) {

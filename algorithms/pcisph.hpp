@@ -7,6 +7,7 @@
 // and would make δ twice too soft.) Boundary particles mirror the fluid pressure (Akinci 2012):
 // -ψ_b (p_i/ρ_i²) ∇W_ib with ψ_b = ρ0 V_b.
 #pragma once
+#include "algorithms/lsm_regions.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/sph_kernels.hpp"
 #include "algorithms/virtual_boundary.hpp"
@@ -129,16 +130,16 @@ inline void predict_positions(std::size_t fluid_count, View<const Vec3> position
 // will be"). Static boundary particles stay put.
 struct SolidLookahead {
     const Vec3* velocity = nullptr;            // the store's; null: every boundary particle where it is
-    const Vec3* object_velocity = nullptr;     // per object, its mean velocity
-    const std::uint8_t* object_rigid = nullptr;  // per object, 1 if rigid
-    const std::int32_t* solid_slot = nullptr;  // the store's solid_slot field (solid_bodies.hpp)
-    const std::int32_t* slot_object = nullptr; // per IBP and SBP slot, its object
+    const Vec3* object_velocity = nullptr;        // per object, its mean velocity
+    const LsmObjectParams* objects = nullptr;     // per object: whether it is rigid
+    const std::int32_t* solid_slot = nullptr;     // the store's solid_slot field (solid_bodies.hpp)
+    const std::int32_t* slot_object = nullptr;    // per IBP and SBP slot, its object
     std::size_t end = 0;                       // the moving solids' boundary particles end here
     Real dt = 0;
     MW_INLINE Vec3 place(std::uint32_t b, Vec3 xb) const {
         if (!velocity || b >= end) return xb;
         const std::int32_t o = slot_object[solid_slot[b]];
-        return xb + dt * (object_rigid[o] ? velocity[b] : object_velocity[o]);
+        return xb + dt * (objects[o].rigid ? velocity[b] : object_velocity[o]);
     }
 };
 

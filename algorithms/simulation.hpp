@@ -86,9 +86,9 @@ struct SimulationParams {
     Real solid_slip = 1;
     // PCISPH solves against the moving solids' boundary particles where they will be at the end
     // of the step, not where they start it (pcisph.hpp, SolidLookahead; the scenes'
-    // coupling.predict_solids). On, unlike the switches above: it mends the step's order (a solid
-    // entering the fluid at the CFL step blew the pool up) at little cost at rest (docs/coupling.md).
-    bool solid_prediction = true;
+    // coupling.predict_solids). Off unless asked for, like the switches above; without it a solid
+    // entering the fluid at the CFL step can blow the pool up (docs/coupling.md).
+    bool solid_prediction = false;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;

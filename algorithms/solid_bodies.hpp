@@ -78,7 +78,6 @@ class SolidBodies {
         rest_.upload(L.ibp_rest);
         mass_.upload(L.ibp_mass);
         split_mass_.upload(L.ibp_split_mass);
-        object_.upload(L.ibp_object);
         pinned_.upload(L.ibp_pinned);
         regions_begin_.upload(L.ibp_regions_begin);
         regions_end_.upload(L.ibp_regions_end);
@@ -122,19 +121,16 @@ class SolidBodies {
             if (setup.solids[o].kind != SolidKind::kStatic)
                 sbp_object_.insert(sbp_object_.end(), setup.solids[o].sbp.size(), std::int32_t(o));
         if (sbp_object_.size() != sbp_count_) throw InputError("simulation setup: the SBPs' count differs from the layout's");
-        // The lookahead's (pcisph.hpp, SolidLookahead): each IBP's and SBP's object by slot, each
-        // object's IBP slots (contiguous, objects in order; static objects: none) for its mean
-        // velocity, and whether it is rigid.
+        // Each IBP's and SBP's object by slot (LSM reads the IBPs'; the lookahead, pcisph.hpp
+        // SolidLookahead, both), and each object's IBP slots (contiguous, objects in order;
+        // static objects: none) for its mean velocity.
         std::vector<std::int32_t> slot_object(L.ibp_object.begin(), L.ibp_object.end());
         slot_object.insert(slot_object.end(), sbp_object_.begin(), sbp_object_.end());
-        slot_object_.upload(slot_object);
+        object_.upload(slot_object);
         std::vector<std::uint32_t> ibp_begin(object_count_ + 1, 0);
         for (std::size_t s = 0; s < ibp_count_; ++s) ++ibp_begin[std::size_t(L.ibp_object[s]) + 1];
         for (std::size_t o = 0; o < object_count_; ++o) ibp_begin[o + 1] += ibp_begin[o];
         object_ibp_begin_.upload(ibp_begin);
-        std::vector<std::uint8_t> rigid(object_count_, 0);
-        for (std::size_t o = 0; o < object_count_; ++o) rigid[o] = setup.solids[o].kind == SolidKind::kRigid;
-        object_rigid_.upload(rigid);
         object_velocity_.assign(object_count_, Vec3{0, 0, 0});
         // Interface tension (interface_tension.hpp): each SBP's η, its object's; none stored when
         // no object has any.
@@ -216,9 +212,9 @@ class SolidBodies {
         SolidLookahead l;
         l.velocity = velocity;
         l.object_velocity = mean;
-        l.object_rigid = object_rigid_.view().data();
+        l.objects = objects_.view().data();
         l.solid_slot = solid_slot_->cview().data();
-        l.slot_object = slot_object_.view().data();
+        l.slot_object = object_.view().data();
         l.end = solid_end;
         return l;
     }
@@ -309,7 +305,7 @@ class SolidBodies {
     // the host: for tests and reports, not for the step.
     std::vector<std::array<double, 3>> object_forces() const {
         if (!coupled()) return sum_by_object({}, {});
-        return sum_by_object(force_.to_host(), object_.to_host());
+        return sum_by_object(force_.to_host(), object_.to_host());  // force_: the IBP slots only
     }
     // The impulse each object's SBPs took in the last step's velocity–position correction, which
     // the next step's coupling applies (kg m/s, summed in double on the host; 0 without it). For
@@ -349,7 +345,7 @@ class SolidBodies {
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
-               slot_object_.bytes() + object_ibp_begin_.bytes() + object_rigid_.bytes() + object_velocity_.bytes();
+               object_ibp_begin_.bytes() + object_velocity_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -450,7 +446,7 @@ class SolidBodies {
     DeviceArray<std::uint32_t> store_of_slot_;
     DeviceArray<Vec3> rest_;
     DeviceArray<Real> mass_, split_mass_;
-    DeviceArray<std::int32_t> object_;
+    DeviceArray<std::int32_t> object_;  // per IBP and SBP slot, its object (index into setup.solids)
     DeviceArray<std::uint8_t> pinned_;
     DeviceArray<std::uint32_t> regions_begin_, regions_end_;
     DeviceArray<Vec3> force_;  // per IBP, the coupling's (empty without it)
@@ -482,9 +478,7 @@ class SolidBodies {
     DeviceArray<Real> sbp_inverse_mass_;
     DeviceArray<Vec3> sbp_impulse_;
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
-    DeviceArray<std::int32_t> slot_object_;        // per IBP and SBP slot, its object
     DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
-    DeviceArray<std::uint8_t> object_rigid_;       // per object, 1 if rigid
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
 };

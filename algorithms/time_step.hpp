@@ -51,11 +51,13 @@ class BackendSimulation final : public Simulation {
         if (has_solid_contact_) mark_fluid_near_solids(fluid_count, grid, fluid_near_solid_.view());
         timers_.stop(kNeighbors);
 
-        // 2. Boundary volumes of moving solids (static ones were computed once).
+        // 2. Boundary volumes of moving solids (static ones were computed once), and where PCISPH
+        //    will meet them (pcisph.hpp, SolidLookahead: each soft object's mean velocity).
         if (has_solid_volumes_) {
             timers_.start(kSolidVolumes);
             compute_boundary_volumes(grid, store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
                                      ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+            if (predicts_solids_) lookahead_ = solids_.lookahead(store_, ranges_.solid_end);
             timers_.stop(kSolidVolumes);
         }
 
@@ -83,8 +85,6 @@ class BackendSimulation final : public Simulation {
             timers_.stop(kInterfaceTension);
         }
         const Vec3* nonpressure = has_viscosity_ || has_tension_ ? nonpressure_.view().data() : nullptr;
-        //    Where PCISPH will meet the moving solids (pcisph.hpp, SolidLookahead).
-        if (predicts_solids_) lookahead_ = solids_.lookahead(store_, ranges_.solid_end);
         // The moving solids' surface for the velocity–position correction (its position rule in
         // PCISPH, then the whole rule after the integration); none without it.
         SolidSurface solid_surface;

@@ -208,15 +208,7 @@ int command_run(int argc, char** argv) {
     if (scene.writes_vtu()) {
         frames = std::make_unique<FrameWriter>(out_dir);
         frames->set_objects(setup.solids);
-        if (continues_directory) {
-            std::vector<std::pair<double, std::string>> kept;
-            for (int k = 0; k < first_frame; ++k) {
-                char name[64];
-                std::snprintf(name, sizeof name, "particles_%05d.vtu", k);
-                if (std::filesystem::exists(frames->directory() + "/" + name)) kept.emplace_back(frame_times[k], name);
-            }
-            frames->keep_earlier(std::move(kept));
-        }
+        if (continues_directory) frames->keep_earlier(frame_times);
     }
     StatsTable stats(sim->stage_names());
     if (continues_directory) stats.keep_earlier_rows(stats_rows_up_to(stats_path, stats.header(), resume->step));

@@ -55,8 +55,8 @@ void remove_earlier_frames(const std::string& out_dir, int keep_below) {
             const std::string extension = std::filesystem::path(frame_name).extension().string();
             const bool frame = (frame_name.rfind("particles_", 0) == 0 && extension == ".vtu") ||
                                (frame_name.rfind("object_", 0) == 0 && extension == ".obj");
-            const bool kept = frame && tmp == std::string::npos && frame_number(frame_name, extension) >= 0 &&
-                              frame_number(frame_name, extension) < keep_below;
+            const int number = frame ? frame_number(frame_name, extension) : -1;
+            const bool kept = tmp == std::string::npos && number >= 0 && number < keep_below;
             if ((frame && !kept) || frame_name == "particles.pvd") std::filesystem::remove(entry.path(), error);
         }
         std::filesystem::remove(frames_dir, error);  // only if now empty: a user's own files stay
@@ -74,9 +74,14 @@ FrameWriter::FrameWriter(const std::string& out_dir) : frames_dir_(out_dir + "/f
     make_directories(frames_dir_);
 }
 
-std::string FrameWriter::write(int index, const HostParticles& p, double time) {
+std::string FrameWriter::particles_name(int index) {
     char name[64];
     std::snprintf(name, sizeof name, "particles_%05d.vtu", index);
+    return name;
+}
+
+std::string FrameWriter::write(int index, const HostParticles& p, double time) {
+    const std::string name = particles_name(index);
     const std::string path = frames_dir_ + "/" + name;
     std::vector<VtuArray> arrays;
     arrays.push_back(VtuArray::vector3("velocity", p.velocity));
@@ -92,8 +97,12 @@ std::string FrameWriter::write(int index, const HostParticles& p, double time) {
     return path;
 }
 
-void FrameWriter::keep_earlier(std::vector<std::pair<double, std::string>> frames) {
-    collection_ = std::move(frames);
+void FrameWriter::keep_earlier(const std::vector<double>& frame_times) {
+    collection_.clear();
+    for (std::size_t k = 0; k < frame_times.size(); ++k) {
+        const std::string name = particles_name(static_cast<int>(k));
+        if (std::filesystem::exists(frames_dir_ + "/" + name)) collection_.emplace_back(frame_times[k], name);
+    }
     write_collection();
 }
 

@@ -34,13 +34,14 @@ class FrameWriter {
     // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView
     // collection listing every frame with its time. Returns the frame's path.
     std::string write(int index, const HostParticles& particles, double time);
-    // A resumed run: the frames already in the directory (time, file name), which particles.pvd
-    // keeps listing before the new ones; rewrites particles.pvd at once.
-    void keep_earlier(std::vector<std::pair<double, std::string>> frames);
+    // A resumed run in its checkpoint's directory: frames 0 .. frame_times.size() - 1 (those of
+    // them still there), which particles.pvd keeps listing before the new ones; rewrites it at once.
+    void keep_earlier(const std::vector<double>& frame_times);
     int written() const { return written_; }  // by this run
     const std::string& directory() const { return frames_dir_; }
 
    private:
+    static std::string particles_name(int index);  // particles_NNNNN.vtu
     void write_objects(int index, const HostParticles& particles) const;
     void write_collection() const;
     std::string frames_dir_;

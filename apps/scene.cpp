@@ -408,11 +408,9 @@ void read_coupling(Section s, Scene& scene) {
     scene.params.two_way_coupling = s.boolean("two_way", false);
     scene.params.solid_correction = s.boolean("correction", false);
     scene.params.solid_slip = Real(s.number("slip", 1.0, Range{0, 1}));
-    // On by default, unlike the switches above: it mends the step's order (PCISPH met a solid where
-    // it started the step, and a solid entering the fluid at the CFL step blew the pool up) at
-    // little cost at rest; false gives the earlier order (docs/coupling.md, "Solids met where they
-    // will be").
-    scene.params.solid_prediction = s.boolean("predict_solids", true);
+    // Off unless asked for too, though without it a solid entering the fluid at the CFL step can
+    // blow the pool up (docs/coupling.md, "Solids met where they will be"); `meltwater info` says so.
+    scene.params.solid_prediction = s.boolean("predict_solids", false);
     s.finish();
 }
 

@@ -23,24 +23,14 @@ bool bitwise_equal(const HostParticles& a, const HostParticles& b) {
            !std::memcmp(a.pressure.data(), b.pressure.data(), a.pressure.size() * sizeof(Real)) && a.type == b.type;
 }
 
-// A column falling in a tank in CFL mode (the step size's limit and growth are state), with an
-// elastic box thrown into it under two-way coupling and the correction (the regions' rotations,
-// the surface normals and the pending contact impulses are state).
+// A box thrown into a pool in CFL mode (the step size's limit and growth are state): an elastic
+// box under two-way coupling, the correction and the lookahead (the regions' rotations, the
+// surface normals and the pending contact impulses are state), meeting the water in the run's
+// second half.
 SimulationSetup column_and_thrown_box() {
-    const Real r0 = 0.02f;
-    SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.6f, 0.5f, 0.2f}, {0, 0, 0}, {0.3f, 0.24f, 0.2f}, r0, 0.004f);
-    setup.params.solver.dt_mode = TimeStepMode::kCfl;
-    setup.params.solver.eta_max = 0.05f;
-    setup.params.fluid.viscosity = 0.01f;
-    setup.params.two_way_coupling = true;
+    SimulationSetup setup = test::box_thrown_onto_pool(SolidKind::kElastic, 500, 0.11);
     setup.params.solid_correction = true;
-    SolidSetup solid;
-    solid.name = "jelly";
-    solid.kind = SolidKind::kElastic;
-    solid.density = 500;
-    solid.stiffness = 0.5f;
-    solid.damping = 2;
-    test::add_box_solid(setup, Vec3d(0.1, 0.1, 0.1), Vec3d(0.15, 0.40, 0.1), solid, Vec3{1.0f, -2.0f, 0});
+    setup.params.solid_prediction = true;
     return setup;
 }
 }  // namespace

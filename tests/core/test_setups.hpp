@@ -291,6 +291,27 @@ inline SettledColumn settle_column(Simulation& sim, const SimulationParams& para
     return out;
 }
 
+// A 0.1 m box (`kind`, `density`, stiffness 0.5, damping 2/s) thrown at (1, -2, 0) m/s from
+// `drop` above a resting pool 0.24 m deep (a 0.3 x 0.24 x 0.2 m block in a 0.6 x 0.5 x 0.2 m tank,
+// r0 = 0.02 m), two-way coupling, CFL steps up to 4 ms with eta_max 5%, μ = 0.01 Pa·s. Callers
+// switch the correction and the lookahead in `setup.params` (the impact and checkpoint tests).
+inline SimulationSetup box_thrown_onto_pool(SolidKind kind, double density, double drop) {
+    const Real r0 = 0.02f;
+    SimulationSetup setup = fluid_in_box({0, 0, 0}, {0.6f, 0.5f, 0.2f}, {0, 0, 0}, {0.3f, 0.24f, 0.2f}, r0, 0.004f);
+    setup.params.solver.dt_mode = TimeStepMode::kCfl;
+    setup.params.solver.eta_max = 0.05f;
+    setup.params.fluid.viscosity = 0.01f;
+    setup.params.two_way_coupling = true;
+    SolidSetup solid;
+    solid.name = "box";
+    solid.kind = kind;
+    solid.density = Real(density);
+    solid.stiffness = 0.5f;
+    solid.damping = 2;
+    add_box_solid(setup, Vec3d(0.1, 0.1, 0.1), Vec3d(0.15, 0.24 + drop + 0.05, 0.1), solid, Vec3{1.0f, -2.0f, 0});
+    return setup;
+}
+
 // A 0.12 m cube of fluid at `speed` along +x toward a free cube of solid (0.12 m, density 1000,
 // `kind`, stiffness 0.5) at rest 2 r0 ahead of it, in an open domain (0.8 x 0.4 x 0.4 m) with no
 // gravity, r0 = 0.02 m, steps of `dt` (the coupling's momentum tests). Callers switch the

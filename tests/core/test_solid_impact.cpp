@@ -1,6 +1,6 @@
 // A solid thrown flat onto a resting pool at the CFL step. PCISPH solves against where the
-// solid's boundary particles will be at the end of the step (coupling.predict_solids, on by
-// default; pcisph.hpp, SolidLookahead). Solved against where they started it, the box's face
+// solid's boundary particles will be at the end of the step (coupling.predict_solids; pcisph.hpp,
+// SolidLookahead). Solved against where they started it, the box's face
 // landed up to 0.4 r0 inside the top fluid layer each step, and at one entry phase a fluid
 // particle was left 0.59 r0 under its surface particles: PCISPH diverged at every halving of the
 // step and the pool blew up (fluid at 400 m/s).
@@ -22,26 +22,12 @@ struct Impact {
     double box_speed_at_entry = 0;  // m/s, in the last step before the water reached it
 };
 
-// A 0.1 m box of `density`, its bottom `drop` above a 0.24 m pool at r0 = 0.02 m (0.6 x 0.5 x
-// 0.2 m tank), thrown at (1, -2, 0) m/s, two-way, CFL steps (cfl 0.4, eta_max 5%); 0.2 s.
+// test::box_thrown_onto_pool, its bottom `drop` above the pool, for 0.2 s.
 Impact throw_box(SolidKind kind, double density, double drop, bool correction, bool prediction) {
     const Real r0 = 0.02f;
-    SimulationSetup setup =
-        test::fluid_in_box({0, 0, 0}, {0.6f, 0.5f, 0.2f}, {0, 0, 0}, {0.3f, 0.24f, 0.2f}, r0, 0.004f);
-    setup.params.solver.dt_mode = TimeStepMode::kCfl;
-    setup.params.solver.eta_max = 0.05f;
-    setup.params.fluid.viscosity = 0.01f;
-    setup.params.two_way_coupling = true;
+    SimulationSetup setup = test::box_thrown_onto_pool(kind, density, drop);
     setup.params.solid_correction = correction;
     setup.params.solid_prediction = prediction;
-    SolidSetup solid;
-    solid.name = "box";
-    solid.kind = kind;
-    solid.density = Real(density);
-    solid.stiffness = 0.5f;
-    solid.damping = 2;
-    test::add_box_solid(setup, Vec3d(0.1, 0.1, 0.1), Vec3d(0.15, 0.24 + drop + 0.05, 0.1), solid,
-                        Vec3{1.0f, -2.0f, 0});
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
     Impact out;
     while (sim->time() < 0.2) {
