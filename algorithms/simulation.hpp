@@ -89,6 +89,17 @@ struct SimulationParams {
     // coupling.predict_solids). Off unless asked for, like the switches above; without it a solid
     // entering the fluid at the CFL step can blow the pool up (docs/coupling.md).
     bool solid_prediction = false;
+    // Heat conduction (algorithms/heat.hpp): every fluid particle and every particle of a moving
+    // solid carries a temperature (SimulationSetup::temperature) that diffuses at its material's
+    // thermal diffusivity; static boundaries are adiabatic. Off unless asked for (the scenes'
+    // heat.enabled): without it no temperature is stored and the stage does not run.
+    struct Heat {
+        bool enabled = false;
+        Real fluid_diffusivity = Real(1.43e-7);  // α of the fluid, m²/s (water at 20 °C)
+        // Explicit sub-steps per step (heat.hpp): as many as the most diffusive material needs
+        // for stability on a full lattice, at most this.
+        int max_substeps = 32;
+    } heat;
     Vec3 gravity{0, -9.81f, 0};
     FluidParams fluid;
     SolverParams solver;
@@ -117,6 +128,7 @@ struct SolidSetup {
     Real damping = 0;             // 1/s: rate at which non-rigid velocity in each region decays
     Real wall_friction = 0.2;     // [0, 1]: share of tangential velocity removed per wall contact
     Real interface_tension = 0;   // η of Eq. 9 between its SBPs and the fluid, m⁴ kg⁻¹ s⁻² (interface_tension.hpp)
+    Real thermal_diffusivity = Real(1.43e-7);  // α, m²/s, with params.heat (heat.hpp)
     // IBPs: index in the setup's lists, integer lattice coordinates, pinned flag (empty = none).
     std::vector<std::uint32_t> ibp;
     std::vector<std::array<int, 3>> lattice;
@@ -145,6 +157,9 @@ struct SimulationSetup {
     std::vector<std::uint8_t> type;
     std::vector<std::int32_t> object;  // -1 for fluid and domain walls; static boxes, then objects
     std::vector<SolidSetup> solids;
+    // Initial temperature of every particle, °C (any consistent unit), with params.heat only:
+    // empty otherwise.
+    std::vector<Real> temperature;
 };
 
 // The particle state copied back to the host for output.
@@ -153,6 +168,7 @@ struct HostParticles {
     std::vector<Real> density, pressure;
     std::vector<std::uint8_t> type;
     std::vector<std::int32_t> object;
+    std::vector<Real> temperature;  // empty without heat conduction
 };
 
 struct StepReport {
@@ -167,6 +183,7 @@ struct StepReport {
     long lost_particles = 0;   // fluid particles that have left the domain so far
     double solid_kinetic_energy = 0;  // J over the IBPs of moving solids
     double solid_max_speed = 0;       // m/s over the same
+    int heat_substeps = 0;  // the heat stage's sub-steps this step (heat.hpp); 0 without it
     int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged or ran out of iterations
     bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
     bool unconverged = false;  // the last try ran out of iterations above η (or eta_max), without diverging

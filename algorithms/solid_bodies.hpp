@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "algorithms/coupling.hpp"
+#include "algorithms/heat.hpp"
 #include "algorithms/interface_tension.hpp"
 #include "algorithms/lsm.hpp"
 #include "algorithms/particle_store.hpp"
@@ -141,6 +142,12 @@ class SolidBodies {
             any_tension = any_tension || sbp_eta[k] > Real(0);
         }
         if (any_tension) sbp_eta_.upload(sbp_eta);
+        // Heat conduction (heat.hpp): each object's thermal diffusivity.
+        if (setup.params.heat.enabled) {
+            std::vector<Real> diffusivity;
+            for (const SolidSetup& solid : setup.solids) diffusivity.push_back(solid.thermal_diffusivity);
+            object_diffusivity_.upload(diffusivity);
+        }
         // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
         // forces act through the regions (lsm.hpp, LsmData::forces).
         const bool any_fluid = std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end();
@@ -300,6 +307,14 @@ class SolidBodies {
         return t;
     }
 
+    // Heat conduction (heat.hpp): how a sweep finds a solid particle's diffusivity.
+    void describe_heat(HeatMaterials& m) const {
+        if (!active()) return;
+        m.solid_slot = solid_slot_->cview();
+        m.slot_object = object_.view().data();
+        m.object_diffusivity = object_diffusivity_.view().data();
+    }
+
     // The force on each object's IBPs in the last step (N, summed in double on the host),
     // indexed like SimulationSetup::solids; static objects and uncoupled runs give 0. A copy to
     // the host: for tests and reports, not for the step.
@@ -345,7 +360,7 @@ class SolidBodies {
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
-               object_ibp_begin_.bytes() + object_velocity_.bytes();
+               object_ibp_begin_.bytes() + object_velocity_.bytes() + object_diffusivity_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -480,6 +495,7 @@ class SolidBodies {
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
     DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
+    DeviceArray<Real> object_diffusivity_;         // per object, α (heat conduction only)
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
 };
 

@@ -52,6 +52,14 @@ struct RadialKernel {
         const Real inv_r = apart ? Real(1) / (apart ? r : Real(1)) : Real(0);
         return (profile().dW_of_q(r * inv_h) * inv_r) * r_vec;
     }
+    // -(dW/dr) / r: the weight of Brookshaw's Laplacian, ∇²A_i ≈ 2 Σ_j V_j (A_j - A_i) (this),
+    // never negative (heat.hpp). From r², branch-free; 0 for r = 0 and out of range.
+    MW_INLINE Real laplacian_weight_r2(Real r2) const {
+        const bool apart = r2 > Real(1e-18) * h * h;
+        const Real r = std::sqrt(r2);
+        const Real inv_r = apart ? Real(1) / (apart ? r : Real(1)) : Real(0);
+        return -profile().dW_of_q(r * inv_h) * inv_r;
+    }
     // Laplacian of the viscosity kernel; never negative, so viscosity never injects energy.
     MW_INLINE Real laplacian_visc(Real r) const { return r < h ? visc_scale * (h - r) : Real(0); }
     // The same from r², branch-free like W_r2 (0 out of range by itself).

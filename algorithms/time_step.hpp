@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "algorithms/coupling.hpp"
+#include "algorithms/heat.hpp"
 #include "algorithms/interface_tension.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/neighbor_list.hpp"
@@ -126,6 +127,29 @@ class BackendSimulation final : public Simulation {
             step_size_.after_step(retries, outcome == PcisphOutcome::kConverged, dt);
         }
 
+        // 4b. Heat conduction (heat.hpp) over this step's neighbourhood: here, where the step's
+        //     length is settled (PCISPH may have halved it) and nothing has moved yet.
+        if (has_heat_) {
+            timers_.start(kHeat);
+            if (solids_.active() && !has_solid_volumes_)  // no fluid: the solids' volumes are the heat's own
+                compute_boundary_volumes(grid, store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
+                                         ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+            HeatMaterials materials;
+            materials.type = store_.type.cview();
+            materials.density = store_.density.cview();
+            materials.boundary_volume = boundary_volume_.cview();
+            materials.fluid_diffusivity = params_.heat.fluid_diffusivity;
+            materials.fluid_mass = fluid_.mass;
+            solids_.describe_heat(materials);
+            if (use_lists_)
+                heat_.step(lists_.view(), grid, fluid_count, ranges_.solid_end, store_.position.cview(), materials,
+                           temperature_->view(), dt, fluid_.kernel);
+            else
+                heat_.step(grid, grid, fluid_count, ranges_.solid_end, store_.position.cview(), materials,
+                           temperature_->view(), dt, fluid_.kernel);
+            timers_.stop(kHeat);
+        }
+
         // 5. Two-way coupling: the reaction of every force the fluid felt from a moving solid's
         //    boundary particles, onto the solid's IBPs (coupling.hpp).
         if (has_coupling_) {
@@ -194,6 +218,7 @@ class BackendSimulation final : public Simulation {
             report_non_finite(solids_.store_index_of_slot(solid_motion.first_bad), "solid inner particle (IBP)");
         fill_report(dt, iterations, error, fluid_count, motion);
         report_.retries = retries;
+        report_.heat_substeps = has_heat_ ? heat_.last_substeps() : 0;
         report_.diverged = outcome == PcisphOutcome::kDiverged;
         report_.unconverged = outcome == PcisphOutcome::kOutOfIterations;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
@@ -218,7 +243,7 @@ class BackendSimulation final : public Simulation {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
                pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
                contact_boxes_.bytes() + contact_objects_.bytes() + contact_object_distances_.bytes() +
-               impulse_per_weight_.bytes() + fluid_near_solid_.bytes() +
+               impulse_per_weight_.bytes() + fluid_near_solid_.bytes() + heat_.bytes() +
                backend_scratch_bytes();
     }
     double time() const override { return time_; }
@@ -295,6 +320,7 @@ class BackendSimulation final : public Simulation {
         kViscosity,
         kInterfaceTension,
         kPcisph,
+        kHeat,
         kCoupling,
         kLsm,
         kIntegrate,
@@ -302,7 +328,7 @@ class BackendSimulation final : public Simulation {
         kStageCount
     };
     static constexpr const char* kStageNames[kStageCount] = {
-        "neighbors", "solid_volumes", "viscosity", "interface_tension", "pcisph",
+        "neighbors", "solid_volumes", "viscosity", "interface_tension", "pcisph", "heat",
         "coupling",  "lsm",           "integrate", "solid_contact"};
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
@@ -376,6 +402,9 @@ class BackendSimulation final : public Simulation {
     DeviceArray<std::uint8_t> fluid_near_solid_;  // its gathers' mask, per fluid particle (virtual_boundary.hpp)
     Real contact_band_ = 0;                 // its band c, m
     SolidBodies solids_;
+    bool has_heat_ = false;                     // heat conduction (heat.hpp)
+    DeviceArray<Real>* temperature_ = nullptr;  // its store field
+    HeatConduction heat_;
     ParticleCounts counts_;
     long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
     double time_ = 0;
@@ -432,6 +461,29 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     store_.density.fill(fp.rest_density);
     store_.pressure.fill(Real(0));
     solids_.init(setup, order, store_);  // the solid_slot field, regions, interpolation links
+    has_heat_ = params_.heat.enabled;
+    if (has_heat_) {
+        if (setup.temperature.size() != n)
+            throw InputError("simulation setup: heat conduction needs a temperature for each of the " +
+                             std::to_string(n) + " particles (got " + std::to_string(setup.temperature.size()) + ")");
+        std::vector<Real> temperature(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            temperature[k] = setup.temperature[order[k]];
+            if (!std::isfinite(double(temperature[k])))
+                throw InputError("simulation setup: particle " + std::to_string(order[k]) +
+                                 " has a non-finite temperature");
+        }
+        if (!(params_.heat.fluid_diffusivity >= 0) || !std::isfinite(double(params_.heat.fluid_diffusivity)))
+            throw InputError("simulation setup: the fluid's thermal diffusivity must be finite and >= 0");
+        for (const SolidSetup& solid : setup.solids)
+            if (!(solid.thermal_diffusivity >= 0) || !std::isfinite(double(solid.thermal_diffusivity)))
+                throw InputError("simulation setup: solid \"" + solid.name +
+                                 "\" has a thermal diffusivity that is not finite and >= 0");
+        if (params_.heat.max_substeps < 1)
+            throw InputError("simulation setup: heat conduction needs max_substeps >= 1");
+        temperature_ = &store_.add<Real>("temperature", FieldLife::kPersistent);
+        temperature_->upload(temperature);
+    }
 
     // The grid covers the domain, its walls and one support radius more; fluid that leaves it is
     // counted as lost.
@@ -476,6 +528,13 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     const PrototypeSums sums = prototype_sums(fluid_.kernel, fp.spacing, 3);
     fluid_.mass = static_cast<Real>(fp.rest_density / sums.sum_W);
     delta_times_dt2_ = pcisph_delta(sums, fp.rest_density, fluid_.mass, 1.0);
+    // Brookshaw's Laplacian, rescaled to be exact on the same lattice (heat.hpp).
+    if (has_heat_) {
+        double largest = counts_.by_type[kFluid] > 0 ? double(params_.heat.fluid_diffusivity) : 0.0;
+        for (const SolidSetup& solid : setup.solids)
+            if (solid.kind != SolidKind::kStatic) largest = std::max(largest, double(solid.thermal_diffusivity));
+        heat_.init(moving, params_.heat.max_substeps, heat_lattice_scale(sums), heat_d_per_dt(sums, largest));
+    }
 
     has_fluid_ = counts_.by_type[kFluid] > 0;  // a solids-only scene runs no fluid stage
     use_lists_ = has_fluid_ && (params_.neighbor_lists == SimulationParams::Lists::kAuto
@@ -510,6 +569,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
         predicted_.resize(moving);
     }
     if (has_viscosity_ || has_tension_) nonpressure_.resize(moving);
+    if (has_heat_ && solids_.active() && boundary_volume_.size() == 0) boundary_volume_.resize(n);
     if (has_solid_contact_ && solids_.contact_takes_impulses()) impulse_per_weight_.resize(moving);
     if (has_solid_contact_) fluid_near_solid_.resize(moving);
 
@@ -518,6 +578,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (has_viscosity_) active_stages_.push_back(kViscosity);
     if (has_tension_) active_stages_.push_back(kInterfaceTension);
     if (has_fluid_) active_stages_.push_back(kPcisph);
+    if (has_heat_) active_stages_.push_back(kHeat);
     if (has_coupling_) active_stages_.push_back(kCoupling);
     if (solids_.active()) active_stages_.push_back(kLsm);
     if (has_fluid_) active_stages_.push_back(kIntegrate);
@@ -560,6 +621,13 @@ void BackendSimulation<Kernel>::download(HostParticles& out) const {
     out.pressure.resize(n);
     out.type.resize(n);
     out.object.resize(n);
+    std::vector<Real> temperature;
+    if (temperature_) {
+        temperature = temperature_->to_host();
+        out.temperature.resize(n);
+    } else {
+        out.temperature.clear();
+    }
     // Back to the scene's order, so that frames and cross-backend comparisons line up.
     for (std::size_t k = 0; k < n; ++k) {
         const std::uint32_t i = id[k];
@@ -570,6 +638,7 @@ void BackendSimulation<Kernel>::download(HostParticles& out) const {
         out.pressure[i] = fluid ? pressure[k] : Real(0);
         out.type[i] = type[k];
         out.object[i] = object[k];
+        if (temperature_) out.temperature[i] = temperature[k];
     }
 }
 

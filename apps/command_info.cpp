@@ -56,7 +56,8 @@ int command_info(int argc, char** argv) {
         j["fluid_carved"] = carved_fluid;
         if (scene.walls) j["wall_gap_m"] = wall_gap;  // the first wall layer's distance outside the faces
         j["warnings"] = SceneJson::array();
-        if (const std::string warning = scene.kernel_warning(); !warning.empty()) j["warnings"].push_back(warning);
+        for (const std::string& warning : {scene.kernel_warning(), scene.heat_warning()})
+            if (!warning.empty()) j["warnings"].push_back(warning);
         j["backend"] = backend;
         j["device_bytes"] = bytes;
         j["bytes_per_particle"] = bytes_per_particle;
@@ -183,8 +184,18 @@ int command_info(int argc, char** argv) {
         if (with_tension)
             std::printf("            interface tension (Eq. 9) between the fluid and %ld object(s)\n", with_tension);
     }
-    if (const std::string warning = scene.kernel_warning(); !warning.empty())
-        std::printf("warning     %s\n", warning.c_str());
+    // Heat conduction (docs/heat.md): who conducts, and the Fourier number that sets its sweeps.
+    if (scene.params.heat.enabled) {
+        std::printf("heat        conduction on (heat.enabled) among the fluid and %ld moving object(s); walls, "
+                    "static boxes and static objects are adiabatic; Fourier number alpha dt / r0^2 up to %.3g at the "
+                    "largest step: %d sub-step(s) a step (at most %d)\n",
+                    moving_objects,
+                    scene.largest_heat_diffusivity() * double(solver.dt) / (double(f.spacing) * double(f.spacing)),
+                    std::min(scene.heat_substeps_needed(), scene.params.heat.max_substeps),
+                    scene.params.heat.max_substeps);
+    }
+    for (const std::string& warning : {scene.kernel_warning(), scene.heat_warning()})
+        if (!warning.empty()) std::printf("warning     %s\n", warning.c_str());
     return 0;
 }
 

@@ -231,7 +231,8 @@ int command_run(int argc, char** argv) {
         summary.simulated_time = resume->time;
     }
 
-    if (const std::string warning = scene.kernel_warning(); !warning.empty()) {
+    for (const std::string& warning : {scene.kernel_warning(), scene.heat_warning()}) {
+        if (warning.empty()) continue;
         std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
         summary.warnings.push_back(warning);
     }

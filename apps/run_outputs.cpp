@@ -89,6 +89,7 @@ std::string FrameWriter::write(int index, const HostParticles& p, double time) {
     arrays.push_back(VtuArray::scalar("pressure", to_floats(p.pressure)));
     arrays.push_back(VtuArray::uint8("type", p.type));
     arrays.push_back(VtuArray::int32("object", p.object));
+    if (!p.temperature.empty()) arrays.push_back(VtuArray::scalar("temperature", to_floats(p.temperature)));
     write_vtu(path, p.position, arrays);
     write_objects(index, p);
     ++written_;

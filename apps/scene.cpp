@@ -13,6 +13,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "algorithms/pcisph_delta.hpp"
 #include "backend/errors.hpp"
 #include "sampling/wall_gap.hpp"
 
@@ -66,6 +67,9 @@ struct Range {
         return "finite";
     }
 };
+
+// Temperatures are in °C: not below absolute zero.
+const Range kTemperatureRange{-273.15, std::numeric_limits<double>::infinity(), false, false};
 
 // A number the simulation's scalar type (Real) holds: in range after the conversion, and not so
 // small that it would turn into zero or a subnormal (a time step of 1e-300, say).
@@ -371,6 +375,10 @@ void read_fluid(Section s, Scene& scene) {
                                                                         : KernelKind::kCubicSpline;
     f.viscosity = Real(s.number("viscosity", 0.0, Range::non_negative()));
     f.wall_viscosity = Real(s.number("wall_viscosity", 0.0, Range::non_negative()));
+    // With heat.enabled only (docs/heat.md): the fluid blocks' default temperature, and the
+    // fluid's thermal diffusivity (water's at 20 °C by default).
+    scene.fluid_temperature = Real(s.number("temperature", 20.0, kTemperatureRange));
+    scene.params.heat.fluid_diffusivity = Real(s.number("thermal_diffusivity", 1.43e-7, Range::non_negative()));
     s.finish();
 }
 
@@ -414,6 +422,14 @@ void read_coupling(Section s, Scene& scene) {
     s.finish();
 }
 
+// Heat conduction (docs/heat.md): off unless the scene asks, like every physics switch added after
+// the first release; the materials' temperatures and diffusivities are read with the materials.
+void read_heat(Section s, Scene& scene) {
+    scene.params.heat.enabled = s.boolean("enabled", false);
+    scene.params.heat.max_substeps = s.integer("max_substeps", 32, 1, 1000);
+    s.finish();
+}
+
 void read_neighbors(Section s, Scene& scene) {
     scene.params.ordering =
         s.choice("ordering", "zorder", {"zorder", "linear"}) == "linear" ? CellOrdering::kLinear : CellOrdering::kZOrder;
@@ -443,6 +459,7 @@ void read_fluid_blocks(Section& root, Scene& scene) {
         b.min = s.vec3("min", std::nullopt);
         b.max = checked_box(s, b.min, s.vec3("max", std::nullopt));
         b.velocity = s.vec3("velocity", std::array<double, 3>{0, 0, 0});
+        b.temperature = Real(s.number("temperature", double(scene.fluid_temperature), kTemperatureRange));
         if (!inside(b.min, b.max, scene.params.domain_min, scene.params.domain_max))
             s.fail(s.path(), "the block must lie inside the domain " + describe_box(scene.params.domain_min, scene.params.domain_max));
         check_clear_of_fluid_blocks(s, scene, b.min, b.max);
@@ -529,6 +546,9 @@ void read_objects(Section& root, Scene& scene) {
         o.interface_tension = Real(s.number("interface_tension", 0.0, Range::non_negative()));
         if (o.kind == SolidKind::kStatic && o.interface_tension > 0)
             s.fail(s.key_path("interface_tension"), "is for elastic and rigid objects (this one is static)");
+        o.temperature = Real(s.number("temperature", double(scene.fluid_temperature), kTemperatureRange));
+        o.thermal_diffusivity = Real(s.number("thermal_diffusivity", double(scene.params.heat.fluid_diffusivity),
+                                              Range::non_negative()));
         read_object_lsm(s.object("lsm"), o);
         read_object_pinned(s.object("pinned"), o);
         scene.objects.push_back(o);
@@ -732,6 +752,34 @@ std::string Scene::kernel_warning() const {
     return text;
 }
 
+double Scene::largest_heat_diffusivity() const {
+    double largest = fluid_blocks.empty() ? 0.0 : double(params.heat.fluid_diffusivity);
+    for (const SceneObject& o : objects)
+        if (o.kind != SolidKind::kStatic) largest = std::max(largest, double(o.thermal_diffusivity));
+    return largest;
+}
+
+int Scene::heat_substeps_needed() const {
+    if (!params.heat.enabled) return 0;
+    const FluidParams& f = params.fluid;
+    const double d_per_dt = with_kernel(f.kernel, f.support_radius, [&](const auto& kernel) {
+        return heat_d_per_dt(prototype_sums(kernel, double(f.spacing), 3), largest_heat_diffusivity());
+    });
+    const double needed = std::ceil(d_per_dt * double(params.solver.dt));
+    return needed < 1 ? 1 : needed > 1e9 ? 1000000000 : static_cast<int>(needed);
+}
+
+std::string Scene::heat_warning() const {
+    const int needed = heat_substeps_needed();
+    if (needed <= params.heat.max_substeps) return "";
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "the largest step needs %d heat sub-steps, more than heat.max_substeps (%d): there the heat "
+                  "spreads more slowly than the diffusivities say (docs/heat.md)",
+                  needed, params.heat.max_substeps);
+    return text;
+}
+
 bool Scene::writes_vtu() const {
     for (const auto& f : formats)
         if (f == "vtu") return true;
@@ -763,6 +811,7 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_solver(root.object("solver"), scene);
     read_boundary(root.object("boundary"), scene);
     read_coupling(root.object("coupling"), scene);
+    read_heat(root.object("heat"), scene);
     read_neighbors(root.object("neighbors"), scene);
     read_fluid_blocks(root, scene);
     read_static_boxes(root, scene);

@@ -18,6 +18,7 @@ using SceneJson = nlohmann::ordered_json;  // keeps the keys in the order they w
 struct FluidBlock {
     Vec3 min{}, max{};
     Vec3 velocity{0, 0, 0};
+    Real temperature = 20;  // °C, with heat conduction (fluid.temperature by default)
 };
 
 struct StaticBox {
@@ -39,6 +40,8 @@ struct SceneObject {
     Real damping = 0;
     Real wall_friction = 0.2;
     Real interface_tension = 0;  // η, Eq. 9 (elastic and rigid objects)
+    Real temperature = 20;                    // °C, with heat conduction (fluid.temperature by default)
+    Real thermal_diffusivity = Real(1.43e-7); // m²/s (fluid.thermal_diffusivity by default)
     enum class Pin { kNone, kBox, kHalfSpace } pin = Pin::kNone;
     Vec3 pin_min{}, pin_max{};          // box
     Vec3 pin_point{}, pin_normal{};     // half-space: IBPs with (x - point)·normal < 0 are pinned
@@ -59,6 +62,7 @@ struct Scene {
     // density error above this. Since the walls' correction keeps the fluid inside them, a
     // blow-up no longer shows as lost fluid; it shows as fluid packed far above its rest density.
     double max_density_error = 1.0;
+    Real fluid_temperature = 20;  // fluid.temperature, °C: the fluid blocks' default
     std::vector<FluidBlock> fluid_blocks;
     std::vector<StaticBox> static_boxes;
     std::vector<SceneObject> objects;
@@ -75,6 +79,12 @@ struct Scene {
     // A warning for a kernel the scene's support radius makes unstable ("" when there is none):
     // the cubic spline wider than 2.25 r0 (docs/solver.md, "Kernels").
     std::string kernel_warning() const;
+    // Heat conduction (docs/heat.md): the largest thermal diffusivity among the fluid and the
+    // moving objects, the sub-steps the largest step needs (0 without heat), and a warning when
+    // that is more than heat.max_substeps ("" otherwise).
+    double largest_heat_diffusivity() const;
+    int heat_substeps_needed() const;
+    std::string heat_warning() const;
 };
 
 // The built-in default scene (scenes/dam_break.json, embedded at configure time).

@@ -158,6 +158,10 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     setup.params = scene.params;
     const Real r0 = scene.params.fluid.spacing;
     std::vector<std::size_t> block_end;  // fluid_blocks[i] fills [block_end[i - 1], block_end[i])
+    // With heat conduction, every particle added since the last call starts at `t` (°C).
+    const auto started_at = [&](Real t) {
+        if (scene.params.heat.enabled) setup.temperature.resize(setup.position.size(), t);
+    };
     for (std::size_t i = 0; i < scene.fluid_blocks.size(); ++i) {
         const FluidBlock& b = scene.fluid_blocks[i];
         const std::vector<Vec3> points = fill_box_lattice(b.min, b.max, r0);
@@ -165,6 +169,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             throw InputError(scene.source + ": fluid_blocks[" + std::to_string(i) +
                              "]: the block is thinner than fluid.spacing on some axis and holds no particle");
         append(setup, points, b.velocity, kFluid, -1);
+        started_at(b.temperature);
         block_end.push_back(setup.position.size());
     }
     const Real rb = scene.boundary_spacing();
@@ -176,6 +181,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                sample_container_walls(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers,
                                       scene.wall_gap()),
                Vec3{0, 0, 0}, kStaticBoundary, -1);
+    started_at(scene.fluid_temperature);  // the walls are adiabatic: their temperature is never read
     const std::size_t first_solid = setup.position.size();
     std::vector<Eigen::AlignedBox3d> boxes;
     for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
@@ -191,6 +197,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                static_cast<std::int32_t>(i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }
+    started_at(scene.fluid_temperature);  // static boxes are adiabatic too
     // Every object's mesh and inner particles, kept where there is something for it to overlap.
     // Static solids may overlap one another, so without a moving object there is nothing to check.
     const bool any_moving = std::any_of(scene.objects.begin(), scene.objects.end(),
@@ -209,6 +216,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         solid.damping = o.damping;
         solid.wall_friction = o.wall_friction;
         solid.interface_tension = o.interface_tension;
+        solid.thermal_diffusivity = o.thermal_diffusivity;
         std::function<bool(const Vec3&)> pinned;
         if (o.pin == SceneObject::Pin::kBox) {
             const Vec3 lo = o.pin_min, hi = o.pin_max;
@@ -231,6 +239,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             const std::size_t first = setup.position.size();
             const std::size_t inner = add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
                                                        scene.params.fluid.support_radius, pinned);
+            started_at(o.temperature);
             // Fluid moving into a static object is stopped by its signed distance (only where the
             // correction is on and there is fluid to stop).
             if (o.kind == SolidKind::kStatic && scene.params.wall_correction && !scene.fluid_blocks.empty())
@@ -292,12 +301,14 @@ std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
         setup.velocity[kept] = setup.velocity[i];
         setup.type[kept] = setup.type[i];
         setup.object[kept] = setup.object[i];
+        if (!setup.temperature.empty()) setup.temperature[kept] = setup.temperature[i];
         ++kept;
     }
     setup.position.resize(kept);
     setup.velocity.resize(kept);
     setup.type.resize(kept);
     setup.object.resize(kept);
+    if (!setup.temperature.empty()) setup.temperature.resize(kept);
     for (SolidSetup& solid : setup.solids)
         for (std::vector<std::uint32_t>* list : {&solid.ibp, &solid.gp, &solid.sbp})
             for (std::uint32_t& index : *list) index = new_index[index];

@@ -17,6 +17,9 @@
 //   7. Coupling with moving solids: scenes/floating_boxes.json (two rigid boxes and an elastic
 //      cube settling in a pool) run two-way, with and without the velocity–position correction
 //      against them: steps, ms per step, the coupling stages' share, top speed.
+//   8. Heat conduction: scenes/warm_jelly.json (a warm elastic cube and a warm rigid block in cold
+//      water) without heat, and with it at its diffusivities and at 5 and 25 times them: steps,
+//      ms per step, the heat stage's median and its sub-steps.
 // Prints a Markdown report and, with --out FILE, appends it there, each section as soon as it is
 // measured.
 #include <algorithm>
@@ -47,7 +50,7 @@ struct Options {
     bool quick = false;
     std::string out;
     // The report's sections to run (--sections, comma-separated): all by default.
-    std::vector<std::string> sections{"dams", "splish", "variants", "kernels", "steps", "objects", "coupling"};
+    std::vector<std::string> sections{"dams", "splish", "variants", "kernels", "steps", "objects", "coupling", "heat"};
     bool wants(const std::string& section) const {
         return std::find(sections.begin(), sections.end(), section) != sections.end();
     }
@@ -240,6 +243,15 @@ std::string format_whole_runs(const std::vector<WholeRun>& runs, double end_time
     return t.str();
 }
 
+// The median of a per-step column, "–" when there is none.
+std::string median_text(std::vector<double> v) {
+    if (v.empty()) return "–";
+    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f", v[v.size() / 2]);
+    return text;
+}
+
 std::string format_table(const std::vector<Result>& results) {
     std::ostringstream t;
     std::vector<std::string> stages;
@@ -288,21 +300,21 @@ int main(int argc, char** argv) {
             std::stringstream list(argv[++i]);
             for (std::string name; std::getline(list, name, ',');) {
                 if (!Options{}.wants(name)) {  // the default holds every section
-                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels, steps, objects, coupling)\n",
+                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels, steps, objects, coupling, heat)\n",
                                  name.c_str());
                     return 2;
                 }
                 chosen.push_back(name);
             }
             if (chosen.empty()) {
-                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels, steps, objects, coupling\n");
+                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels, steps, objects, coupling, heat\n");
                 return 2;
             }
             o.sections = chosen;
         } else {
             std::fprintf(stderr,
                          "usage: bench_fluid [--backend openmp|cuda] [--threads N] [--large] [--quick] "
-                         "[--sections dams,splish,variants,kernels,steps,objects,coupling] [--out FILE]\n");
+                         "[--sections dams,splish,variants,kernels,steps,objects,coupling,heat] [--out FILE]\n");
             return 2;
         }
     }
@@ -535,13 +547,6 @@ int main(int argc, char** argv) {
                 };
                 const WholeRun r = run_whole(o, c.name, build_setup(scene), end_time, stage_times);
                 fluid = r.fluid;
-                auto median_text = [](std::vector<double> v) {
-                    if (v.empty()) return std::string("–");
-                    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-                    char text[32];
-                    std::snprintf(text, sizeof text, "%.2f", v[v.size() / 2]);
-                    return std::string(text);
-                };
                 char cell[320];
                 std::snprintf(cell, sizeof cell, "| %s | %ld | %ld | %.2f | %s | %s | %s | %.2f | %.3f |\n", c.name,
                               r.steps, r.halvings, r.ms_total / 1000, median_text(step_ms).c_str(),
@@ -557,6 +562,62 @@ int main(int argc, char** argv) {
               << rows;
             emit(t.str() + "\nThe paper's Table 2 gives 5.3 ms of coupling per step for its Fig. 8 (25k fluid "
                            "particles, 3.5k SBPs, 6k IBPs) on a GTX 690.\n\n");
+        }
+        // Heat conduction (scenes/warm_jelly.json): the stage's cost against the step's, as the
+        // Fourier number, and with it the explicit sub-steps (algorithms/heat.hpp), grows.
+        if (o.wants("heat")) {
+            const double end_time = o.quick ? 0.2 : 0.5;
+            struct HeatCase {
+                std::string name;
+                std::vector<std::string> overrides;
+            };
+            auto scaled = [](double factor) {
+                char fluid[64], jelly[64], block[64];
+                std::snprintf(fluid, sizeof fluid, "fluid.thermal_diffusivity=%g", 0.002 * factor);
+                std::snprintf(jelly, sizeof jelly, "objects.0.thermal_diffusivity=%g", 0.004 * factor);
+                std::snprintf(block, sizeof block, "objects.1.thermal_diffusivity=%g", 0.01 * factor);
+                return std::vector<std::string>{fluid, jelly, block};
+            };
+            const std::vector<HeatCase> cases = {{"heat off", {"heat.enabled=false"}},
+                                                 {"the scene's diffusivities", scaled(1)},
+                                                 {"5 times them", scaled(5)},
+                                                 {"25 times them", scaled(25)}};
+            std::string rows;
+            long fluid = 0;
+            for (const HeatCase& c : cases) {
+                const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/warm_jelly.json", c.overrides);
+                std::vector<double> step_ms, heat_ms, pcisph_ms, substeps;
+                const StepObserver stage_times = [&](Simulation& sim, WholeRun&) {
+                    const std::vector<std::string> names = sim.stage_names();
+                    const StepReport& rep = sim.last_report();
+                    step_ms.push_back(rep.total_ms);
+                    if (rep.heat_substeps > 0) substeps.push_back(rep.heat_substeps);
+                    for (std::size_t k = 0; k < names.size() && k < rep.stage_ms.size(); ++k) {
+                        if (names[k] == "heat") heat_ms.push_back(rep.stage_ms[k]);
+                        if (names[k] == "pcisph") pcisph_ms.push_back(rep.stage_ms[k]);
+                    }
+                };
+                const WholeRun r = run_whole(o, c.name, build_setup(scene), end_time, stage_times);
+                fluid = r.fluid;
+                const double fourier = scene.params.heat.enabled
+                                           ? scene.largest_heat_diffusivity() * double(scene.params.solver.dt) /
+                                                 (double(scene.params.fluid.spacing) * double(scene.params.fluid.spacing))
+                                           : 0.0;
+                char cell[320];
+                std::snprintf(cell, sizeof cell, "| %s | %.3g | %ld | %.2f | %s | %s | %s | %s |\n", c.name.c_str(),
+                              fourier, r.steps, r.ms_total / 1000, median_text(step_ms).c_str(),
+                              median_text(pcisph_ms).c_str(), median_text(heat_ms).c_str(),
+                              median_text(substeps).c_str());
+                rows += cell;
+            }
+            std::ostringstream t;
+            t << "### Heat conduction (scenes/warm_jelly.json: " << fluid
+              << " fluid particles, an elastic cube and a rigid block; to t = " << end_time << " s)\n\n"
+              << "| case | Fourier number at the largest step | steps | s to the end | ms/step, median | pcisph ms, "
+                 "median | heat ms, median | heat sub-steps, median |\n|---|---|---|---|---|---|---|---|\n"
+              << rows;
+            emit(t.str() + "\nThe paper's Table 2 gives no separate figure for heat; its melting scenes (Fig. 11) "
+                           "take 87 and 129 ms per step in all on a GTX 690.\n\n");
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_fluid: %s\n", e.what());

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -94,6 +95,30 @@ inline void check_rejected(const Result& r, const std::vector<std::string>& part
     CHECK(contains(r.err, "meltwater: "));
     CHECK(count_lines(r.err) == 1);
     for (const auto& p : parts) CHECK(contains(r.err, p));
+}
+
+// The tiny scene with a rigid box (0.06 m, 500 kg/m3) beside its fluid, written as `name` (the
+// coupling's tests).
+inline std::string tiny_scene_with_box(const std::string& name) {
+    return scene_file(name, tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
+                                          "transform": {"translation": [0.15, 0.1, 0.1]}, "kind": "rigid", "density": 500}])"));
+}
+// `info SCENE --json OPTIONS`, which must succeed, parsed.
+inline nlohmann::json info_json(const std::string& scene, const std::string& options = "") {
+    const Result r = run("info " + scene + " --json " + options);
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    return nlohmann::json::parse(r.out);
+}
+// The stages it lists, in order.
+inline std::vector<std::string> stages_of(const nlohmann::json& info) {
+    std::vector<std::string> names;
+    for (const auto& s : info["stages"]) names.push_back(s.get<std::string>());
+    return names;
+}
+inline bool runs_stage(const nlohmann::json& info, const std::string& stage) {
+    const std::vector<std::string> names = stages_of(info);
+    return std::find(names.begin(), names.end(), stage) != names.end();
 }
 
 }  // namespace cli_test

@@ -795,31 +795,6 @@ TEST_CASE("guards: a run that loses more fluid through its walls than boundary.m
     }
 }
 
-namespace {
-// The tiny scene with a rigid box (0.06 m, 500 kg/m3) beside its fluid, written as `name` (the
-// coupling's tests).
-std::string tiny_scene_with_box(const std::string& name) {
-    return scene_file(name, tiny_scene_text(R"("objects": [{"mesh": {"procedural": "box:x=0.06,y=0.06,z=0.06"},
-                                          "transform": {"translation": [0.15, 0.1, 0.1]}, "kind": "rigid", "density": 500}])"));
-}
-// `info SCENE --json OPTIONS`, which must succeed, parsed.
-nlohmann::json info_json(const std::string& scene, const std::string& options = "") {
-    const Result r = run("info " + scene + " --json " + options);
-    CAPTURE(r.err);
-    REQUIRE(r.code == 0);
-    return nlohmann::json::parse(r.out);
-}
-// The stages it lists, in order.
-std::vector<std::string> stages_of(const nlohmann::json& info) {
-    std::vector<std::string> names;
-    for (const auto& s : info["stages"]) names.push_back(s.get<std::string>());
-    return names;
-}
-bool runs_stage(const nlohmann::json& info, const std::string& stage) {
-    const std::vector<std::string> names = stages_of(info);
-    return std::find(names.begin(), names.end(), stage) != names.end();
-}
-}  // namespace
 
 TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, when the scene asks for it") {
     const std::string scene = tiny_scene_with_box("coupled.json");
