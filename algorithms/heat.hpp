@@ -3,22 +3,33 @@
 // elastic or rigid object carries a temperature T; static walls, static boxes and static objects
 // are adiabatic (no heat crosses them) and the mesh vertices (GPs) keep their initial value.
 //
-// The heat equation dT/dt = α ∇²T with Brookshaw's (1985) SPH Laplacian, which only needs W'
-// and gives a weight that is never negative:
+// The heat equation C dT/dt = ∇·(k ∇T) with Brookshaw's (1985) SPH Laplacian, which only needs
+// W' and gives a weight that is never negative (Cleary & Monaghan's 1999 form for conduction
+// between materials), written per particle as
 //
-//   dT_i/dt = Σ_j c_ij (T_j - T_i),   c_ij = s (α_i + α_j) V_j F_ij,   F_ij = -W'(r_ij) / r_ij,
+//   M_i dT_i/dt = V_i Σ_j c_ij (T_j - T_i),   c_ij = 2 s k_ij V_j F_ij,   F_ij = -W'(r_ij) / r_ij.
 //
-// α the particle's thermal diffusivity (its material's: the fluid's, or its object's), V_j = m/ρ_j
-// for fluid and the Akinci volume V_b for a solid's particles, and s the lattice factor that makes
-// the sum exact on a regular lattice at spacing r0 (pcisph_delta.hpp, laplacian_moment: at
-// h = 2 r0 the raw sum is 4% slow for the cubic spline). Every particle has the same heat capacity
-// per volume, so Σ_i V_i T_i is the heat, and the pair terms conserve it.
+// C = ρc is the material's heat capacity per volume and k = α C its conductivity (the fluid's, or
+// the particle's object's: the scene gives the diffusivity α and C); k_ij = 2 k_i k_j / (k_i + k_j)
+// the pair's (the two half-spacings in series: right at an interface, and k for one material);
+// V = m/ρ0 for fluid (an incompressible fluid's volume: m/ρ with PCISPH's ρ, which a free surface's
+// missing neighbours lower, made a fluid bar conduct 6% fast) and the Akinci volume V_b, this
+// step's, for a solid's particles; M_i = V⁰_i C_i the particle's heat capacity, fixed: V⁰ is m/ρ0
+// for fluid and a solid particle's V_b as the scene starts (V_b changes as solids deform or pass a
+// wall or one another; a heat content taken with this step's volumes drifted by 0.3% in a pool
+// settling around a box, with m/ρ for the fluid). s is
+// the lattice factor that makes the sum exact on a regular lattice at spacing r0
+// (pcisph_delta.hpp, laplacian_moment: at h = 2 r0 the raw sum is 2% fast for the cubic spline).
+// The heat Σ_i M_i T_i is conserved: V_i c_ij = V_j c_ji, while every particle's update stays
+// within the limit below.
 //
-// Time: explicit sub-steps, as many as keep D = δt Σ_j c_ij at most 1 on a full lattice of the
-// most diffusive material (then each update is a weighted mean of T_i and its neighbours', so no
-// temperature leaves their range), at most `max_substeps`. A particle whose own D exceeds 1 (a
-// denser neighbourhood, or a step past the cap) moves to its neighbours' weighted mean instead of
-// past it: the update stays a mean, stable at any Δt, and only loses rate there.
+// Time: explicit sub-steps, as many as keep g = δt V_i Σ_j c_ij / M_i at most 1 for every particle as
+// the scene starts (HeatConduction::calibrate: the solids' overlapping surface and inner
+// particles reach 1.6 times a fluid lattice's g), at most `max_substeps`. Then each update is a
+// weighted mean of T_i and its neighbours', so no temperature leaves their range. A particle whose
+// g exceeds 1 (a neighbourhood packed tighter than at the start, or a step past the cap) moves to
+// its neighbours' weighted mean instead of past it: the update stays a mean, stable at any Δt,
+// but that particle's exchange is no longer symmetric, so it conserves heat only approximately.
 //
 // METHOD.md's backward Euler (one pass per step, stable at any Δt) was built first, as Jacobi
 // sweeps of the implicit system: one sweep diffuses at 1/(1 + D) of the true rate (0.56 at a
@@ -34,19 +45,28 @@
 #include "algorithms/neighbor_list.hpp"
 #include "algorithms/particle_types.hpp"
 #include "backend/backend.hpp"
+#include "backend/reduce_ops.hpp"
 
 MW_BACKEND_BEGIN
 
-// Where a particle's diffusivity and volume come from (read once per step, by the first pass).
+// A material's thermal properties.
+struct HeatMaterial {
+    Real diffusivity = 0;  // α, m²/s
+    Real capacity = 1;     // C = ρc, J/(m³ K)
+};
+
+// Where a particle's material and volumes come from (read once per step, by the first pass).
 struct HeatMaterials {
     View<const std::uint8_t> type;          // store fields
-    View<const Real> density;               // fluid: V = m/ρ (this step's density)
+    View<const Real> density;               // fluid: this step's ρ, for γ = ρ0/ρ
     View<const Real> boundary_volume;       // solids' particles: V_b (this step's)
     View<const std::int32_t> solid_slot;    // solids' particles: their slot (empty without solids)
-    const std::int32_t* slot_object = nullptr;  // slot -> index of its object in the setup's solids
-    const Real* object_diffusivity = nullptr;   // α per object, m²/s
-    Real fluid_diffusivity = 0;             // α of the fluid, m²/s
+    const std::int32_t* slot_object = nullptr;    // slot -> index of its object in the setup's solids
+    const HeatMaterial* objects = nullptr;        // per object
+    std::size_t solid_slots = 0;                  // IBP and SBP slots (the solids' conducting particles)
+    HeatMaterial fluid;
     Real fluid_mass = 0;
+    Real rest_density = 0;  // ρ0: the fluid's V⁰ = m/ρ0
 };
 
 // A pass's two sums for particle i: Σ_j c_ij and Σ_j c_ij T_j (c without δt s).
@@ -74,29 +94,56 @@ MW_INLINE HeatSums sum_conducting(const NeighborListView& lists, std::size_t i, 
     return sums;
 }
 
+// A particle's conduction data for a step: its volume V, conductivity k, and V/M (M its heat
+// capacity, J/K).
+struct HeatParticle {
+    Real volume = 0, conductivity = 0, volume_per_capacity = 0;
+    Real deficiency = 1;  // γ
+};
+
+// The pair term of c_ij / (2 s): k_ij V_j F_ij, from i's conductivity and j's data; 0 for a j at
+// or past `end` (a static neighbour in the lists), which reads particle 0's data instead.
+template <class Kernel>
+MW_INLINE Real heat_pair(Vec3 xi, Real k_i, Real gamma_i, std::uint32_t j, std::size_t end, View<const Vec3> position,
+                         View<const HeatParticle> particle, Kernel kernel, std::uint32_t& read) {
+    const bool conducts = j < end;
+    read = conducts ? j : 0u;
+    const HeatParticle pj = particle[read];
+    const Real f = conducts ? kernel.laplacian_weight_r2(norm2(xi - position[j])) : Real(0);
+    const Real k_sum = k_i + pj.conductivity;
+    const Real k_pair = k_sum > Real(0) ? Real(2) * k_i * pj.conductivity / k_sum : Real(0);
+    return k_pair * pj.volume * f * Real(0.5) * (gamma_i + pj.deficiency);
+}
+
 // One explicit sub-step over particles [first, first + count), from `in` to `out` (never the same):
-// out_i = T_i + λ (a Σ_j c_ij T_j - g T_i), g = a Σ_j c_ij, a = δt s, λ = min(1, 1/g), with
-// c_ij = (α_i V_j + (αV)_j) F_ij from the per-particle V and αV of the moving particles
-// [0, moving): a static neighbour (the lists' boundary entries) reads particle 0's and adds 0.
-// Otherwise branch-free terms (F is 0 out of range and for i itself), as in the PCISPH sums.
+// out_i = T_i + λ (a Σ_j c_ij T_j - g T_i), g = a Σ_j c_ij, a = δt 2 s V_i / M_i, λ = min(1, 1/g),
+// with c_ij = k_ij V_j F_ij over the conducting particles [0, end). Otherwise branch-free terms
+// (F is 0 out of range and for i itself), as in the PCISPH sums.
 template <class Neighbors, class Kernel>
-void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t count, std::size_t moving,
-                  View<const Vec3> position, View<const Real> volume, View<const Real> alpha_volume,
-                  View<const Real> in, View<Real> out, Real dt_times_scale, Kernel kernel) {
+void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t count, std::size_t end,
+                  View<const Vec3> position, View<const HeatParticle> particle, View<const Real> in, View<Real> out,
+                  Real dt_times_scale, Kernel kernel) {
     parallel_for("heat_substep", count, [=] MW_HD(std::size_t k) {
         const std::size_t i = first + k;
         const Vec3 xi = position[i];
-        const Real alpha_i = alpha_volume[i] / volume[i];
+        const Real k_i = particle[i].conductivity, gamma_i = particle[i].deficiency;
         const HeatSums sums = sum_conducting(neighbors, i, xi, [&](std::uint32_t j) {
-            const bool conducts = j < moving;
-            const std::uint32_t jj = conducts ? j : 0u;
-            const Real f = conducts ? kernel.laplacian_weight_r2(norm2(xi - position[j])) : Real(0);
-            const Real c = (alpha_i * volume[jj] + alpha_volume[jj]) * f;
-            return HeatSums{c, c * in[jj]};
+            std::uint32_t read = 0;
+            const Real c = heat_pair(xi, k_i, gamma_i, j, end, position, particle, kernel, read);
+            return HeatSums{c, c * in[read]};
         });
-        const Real g = dt_times_scale * sums.weight;
+        const Real a_i = dt_times_scale * particle[i].volume_per_capacity;
+        const Real g = a_i * sums.weight;
         const Real share = g > Real(1) ? Real(1) / g : Real(1);
-        out[i] = in[i] + share * (dt_times_scale * sums.weighted - g * in[i]);
+        out[i] = in[i] + share * (a_i * sums.weighted - g * in[i]);
+    });
+}
+
+// The heat content Σ M T of particles [0, count), J (T in °C), in double.
+inline double heat_content(std::size_t count, View<const HeatParticle> particle, View<const Real> temperature) {
+    return transform_reduce("heat_content", count, 0.0, SumOp{}, [=] MW_HD(std::size_t i) {
+        const double v_per_m = double(particle[i].volume_per_capacity);
+        return v_per_m > 0 ? double(particle[i].volume) / v_per_m * double(temperature[i]) : 0.0;
     });
 }
 
@@ -104,68 +151,119 @@ void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t cou
 class HeatConduction {
    public:
     // `moving`: the store's moving particles (the most a pass covers); `lattice_scale`: s above;
-    // `d_per_dt`: D / Δt of the most diffusive material (pcisph_delta.hpp, heat_d_per_dt).
+    // `d_per_dt`: g / Δt of a full lattice of the most diffusive material (pcisph_delta.hpp,
+    // heat_d_per_dt), raised by calibrate().
     void init(std::size_t moving, int max_substeps, double lattice_scale, double d_per_dt) {
         max_substeps_ = std::max(1, max_substeps);
         lattice_scale_ = lattice_scale;
         d_per_dt_ = d_per_dt;
-        moving_ = moving;
-        volume_.resize(moving);
-        alpha_volume_.resize(moving);
-        other_.resize(moving);
+        particle_.assign(moving, HeatParticle{});
+        other_.assign(moving, Real(0));
+        solid_rest_volume_.assign(1, Real(0));  // calibrate() sizes it
+        heat_content(moving, particle_.cview(), other_.cview());  // its reduction workspace, before the first step
     }
-    // The sub-steps a step of dt takes: D / n <= 1, at most max_substeps.
-    int substeps_for(double dt) const {
+    // At set-up, with the scene's first volumes and grid: each solid particle's V⁰ (its V_b now),
+    // and the largest g / Δt over particles [0, solid_end), if above the lattice's (the solids'
+    // overlapping surface and inner particles, and the pairs across materials). One neighbour
+    // pass and a reduction.
+    template <class Kernel>
+    void calibrate(const GridView& grid, std::size_t fluid_end, std::size_t solid_end, View<const Vec3> position,
+                   const HeatMaterials& m, Kernel kernel) {
+        solid_rest_volume_.assign(std::max<std::size_t>(1, m.solid_slots), Real(0));
+        if (solid_end == 0) return;
+        const View<Real> rest = solid_rest_volume_.view();
+        if (solid_end > fluid_end)
+            parallel_for("heat_solid_rest_volume", solid_end - fluid_end, [=] MW_HD(std::size_t k) {
+                const std::size_t i = fluid_end + k;
+                rest[static_cast<std::size_t>(m.solid_slot[i])] = m.boundary_volume[i];
+            });
+        describe_particles(solid_end, m, View<const Real>{});
+        const View<const HeatParticle> particle = particle_.cview();
+        const Real two_s = static_cast<Real>(2 * lattice_scale_);
+        const Real largest = transform_reduce("heat_calibrate", solid_end, Real(0), MaxOp{}, [=] MW_HD(std::size_t i) {
+            const Vec3 xi = position[i];
+            const Real k_i = particle[i].conductivity, gamma_i = particle[i].deficiency;
+            Real weight = 0;
+            grid.for_each_fluid(xi, [&](std::uint32_t j) {
+                std::uint32_t read = 0;
+                weight += heat_pair(xi, k_i, gamma_i, j, solid_end, position, particle, kernel, read);
+            });
+            grid.for_each_solid(xi, [&](std::uint32_t j) {
+                std::uint32_t read = 0;
+                weight += heat_pair(xi, k_i, gamma_i, j, solid_end, position, particle, kernel, read);
+            });
+            return two_s * particle[i].volume_per_capacity * weight;
+        });
+        d_per_dt_ = std::max(d_per_dt_, double(largest));
+    }
+    // The sub-steps a step of dt needs (g <= 1 each), and takes (at most max_substeps).
+    int substeps_needed(double dt) const {
         const double n = std::ceil(d_per_dt_ * dt);
-        return n < 1 ? 1 : n > max_substeps_ ? max_substeps_ : static_cast<int>(n);
+        return n < 1 ? 1 : n > 1e9 ? 1000000000 : static_cast<int>(n);
     }
+    int substeps_for(double dt) const { return std::min(substeps_needed(dt), max_substeps_); }
     int last_substeps() const { return last_substeps_; }
-    std::size_t bytes() const { return volume_.bytes() + alpha_volume_.bytes() + other_.bytes(); }
+    std::size_t bytes() const { return particle_.bytes() + other_.bytes() + solid_rest_volume_.bytes(); }
 
     // Advances `temperature` (a store field) by dt over the fluid [0, fluid_end), whose rows come
     // from `fluid_rows` (this step's lists, or the grid), and the moving solids' particles
     // [fluid_end, solid_end) (the grid). The sub-steps alternate between the store's field and
-    // other_, starting where an odd or even count ends in the store.
+    // other_, starting where an odd or even count ends in the store. Returns the heat content
+    // after the step (a reduction read back: the run's conservation check, stats.csv).
     template <class Neighbors, class Kernel>
-    void step(const Neighbors& fluid_rows, const GridView& grid, std::size_t fluid_end, std::size_t solid_end,
-              View<const Vec3> position, const HeatMaterials& m, View<Real> temperature, Real dt, Kernel kernel) {
-        if (solid_end == 0) return;
+    double step(const Neighbors& fluid_rows, const GridView& grid, std::size_t fluid_end, std::size_t solid_end,
+                View<const Vec3> position, const HeatMaterials& m, View<Real> temperature, Real dt, Kernel kernel) {
         const int substeps = substeps_for(double(dt));
         last_substeps_ = substeps;
-        const View<const Real> stored = temperature;
-        const View<Real> other = other_.view(), volume = volume_.view(), alpha_volume = alpha_volume_.view();
-        parallel_for("heat_materials", solid_end, [=] MW_HD(std::size_t i) {
-            other[i] = stored[i];
-            const bool fluid = m.type[i] == kFluid;
-            const Real v = fluid ? m.fluid_mass / m.density[i] : m.boundary_volume[i];
-            const Real alpha = fluid ? m.fluid_diffusivity : m.object_diffusivity[m.slot_object[m.solid_slot[i]]];
-            volume[i] = v;
-            alpha_volume[i] = alpha * v;
-        });
-        const Real a = static_cast<Real>(double(dt) / substeps * lattice_scale_);
+        if (solid_end == 0) return 0;
+        describe_particles(solid_end, m, temperature);
+        const Real a = static_cast<Real>(2 * lattice_scale_ * double(dt) / substeps);
         // An odd count starts from the copy in other_, an even one from the store: the last lands there.
-        View<Real> in = substeps % 2 == 1 ? other : temperature;
-        View<Real> out = substeps % 2 == 1 ? temperature : other;
+        View<Real> in = substeps % 2 == 1 ? other_.view() : temperature;
+        View<Real> out = substeps % 2 == 1 ? temperature : other_.view();
         for (int substep = 0; substep < substeps; ++substep) {
             if (fluid_end > 0)
-                heat_substep(fluid_rows, 0, fluid_end, moving_, position, volume_.cview(), alpha_volume_.cview(), in,
-                             out, a, kernel);
+                heat_substep(fluid_rows, 0, fluid_end, solid_end, position, particle_.cview(), in, out, a, kernel);
             if (solid_end > fluid_end)
-                heat_substep(grid, fluid_end, solid_end - fluid_end, moving_, position, volume_.cview(),
-                             alpha_volume_.cview(), in, out, a, kernel);
+                heat_substep(grid, fluid_end, solid_end - fluid_end, solid_end, position, particle_.cview(), in, out,
+                             a, kernel);
             std::swap(in, out);
         }
+        return heat_content(solid_end, particle_.cview(), temperature);
+    }
+
+    // Each conducting particle's volume, conductivity and V/M for this step, and a copy of
+    // `temperature` (when given) in other_. Public only because nvcc allows no device lambda in a
+    // private member function.
+    void describe_particles(std::size_t solid_end, const HeatMaterials& m, View<const Real> temperature) {
+        const View<Real> other = other_.view();
+        const View<HeatParticle> particle = particle_.view();
+        const View<const Real> rest = solid_rest_volume_.cview();
+        const bool copy = temperature.data() != nullptr;
+        parallel_for("heat_materials", solid_end, [=] MW_HD(std::size_t i) {
+            if (copy) other[i] = temperature[i];
+            const bool fluid = m.type[i] == kFluid;
+            const std::int32_t slot = fluid ? 0 : m.solid_slot[i];
+            const HeatMaterial material = fluid ? m.fluid : m.objects[m.slot_object[slot]];
+            HeatParticle p;
+            const Real rest_volume = fluid ? m.fluid_mass / m.rest_density : rest[static_cast<std::size_t>(slot)];
+            p.volume = fluid ? rest_volume : m.boundary_volume[i];
+            const Real gamma = fluid ? m.rest_density / m.density[i] : Real(1);
+            p.deficiency = gamma < Real(1) ? Real(1) : gamma > Real(3) ? Real(3) : gamma;
+            p.volume_per_capacity = rest_volume > Real(0) ? p.volume / (rest_volume * material.capacity) : Real(0);
+            p.conductivity = material.diffusivity * material.capacity;
+            particle[i] = p;
+        });
     }
 
    private:
     int max_substeps_ = 1;
     double lattice_scale_ = 1;
-    double d_per_dt_ = 0;  // D / Δt for the most diffusive material on a full lattice
+    double d_per_dt_ = 0;  // the largest g / Δt
     int last_substeps_ = 0;
-    std::size_t moving_ = 0;
-    DeviceArray<Real> volume_;        // V per moving particle, this step's
-    DeviceArray<Real> alpha_volume_;  // α V per moving particle, the same
-    DeviceArray<Real> other_;         // the sub-steps' second buffer
+    DeviceArray<HeatParticle> particle_;  // per moving particle, this step's
+    DeviceArray<Real> other_;             // the sub-steps' second buffer
+    DeviceArray<Real> solid_rest_volume_;  // per solid slot (IBPs, SBPs), its V⁰
 };
 
 MW_BACKEND_END

@@ -96,6 +96,7 @@ struct SimulationParams {
     struct Heat {
         bool enabled = false;
         Real fluid_diffusivity = Real(1.43e-7);  // α of the fluid, m²/s (water at 20 °C)
+        Real fluid_capacity = Real(4.18e6);      // ρc of the fluid, J/(m³ K) (water)
         // Explicit sub-steps per step (heat.hpp): as many as the most diffusive material needs
         // for stability on a full lattice, at most this.
         int max_substeps = 32;
@@ -129,6 +130,7 @@ struct SolidSetup {
     Real wall_friction = 0.2;     // [0, 1]: share of tangential velocity removed per wall contact
     Real interface_tension = 0;   // η of Eq. 9 between its SBPs and the fluid, m⁴ kg⁻¹ s⁻² (interface_tension.hpp)
     Real thermal_diffusivity = Real(1.43e-7);  // α, m²/s, with params.heat (heat.hpp)
+    Real heat_capacity = Real(4.18e6);         // ρc, J/(m³ K), with params.heat
     // IBPs: index in the setup's lists, integer lattice coordinates, pinned flag (empty = none).
     std::vector<std::uint32_t> ibp;
     std::vector<std::array<int, 3>> lattice;
@@ -184,6 +186,7 @@ struct StepReport {
     double solid_kinetic_energy = 0;  // J over the IBPs of moving solids
     double solid_max_speed = 0;       // m/s over the same
     int heat_substeps = 0;  // the heat stage's sub-steps this step (heat.hpp); 0 without it
+    double heat_content = 0;  // Σ V ρc T over the conducting particles after the step, J (T in °C); 0 without it
     int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged or ran out of iterations
     bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
     bool unconverged = false;  // the last try ran out of iterations above η (or eta_max), without diverging
@@ -213,6 +216,9 @@ class Simulation {
     virtual ParticleCounts counts() const = 0;
     virtual std::size_t device_bytes() const = 0;
     virtual double time() const = 0;
+    // Heat conduction (heat.hpp): the sub-steps a step of dt needs for every particle's update to
+    // stay a mean (before the cap heat.max_substeps); 0 without heat.
+    virtual int heat_substeps_needed(double dt) const = 0;
     virtual std::string backend_name() const = 0;
     virtual std::string device_name() const = 0;
     // The force the fluid exerted on each solid object in the last step, N, indexed like

@@ -142,11 +142,12 @@ class SolidBodies {
             any_tension = any_tension || sbp_eta[k] > Real(0);
         }
         if (any_tension) sbp_eta_.upload(sbp_eta);
-        // Heat conduction (heat.hpp): each object's thermal diffusivity.
+        // Heat conduction (heat.hpp): each object's thermal diffusivity and heat capacity.
         if (setup.params.heat.enabled) {
-            std::vector<Real> diffusivity;
-            for (const SolidSetup& solid : setup.solids) diffusivity.push_back(solid.thermal_diffusivity);
-            object_diffusivity_.upload(diffusivity);
+            std::vector<HeatMaterial> materials;
+            for (const SolidSetup& solid : setup.solids)
+                materials.push_back(HeatMaterial{solid.thermal_diffusivity, solid.heat_capacity});
+            object_heat_.upload(materials);
         }
         // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
         // forces act through the regions (lsm.hpp, LsmData::forces).
@@ -307,12 +308,13 @@ class SolidBodies {
         return t;
     }
 
-    // Heat conduction (heat.hpp): how a sweep finds a solid particle's diffusivity.
+    // Heat conduction (heat.hpp): how the stage finds a solid particle's material.
     void describe_heat(HeatMaterials& m) const {
         if (!active()) return;
         m.solid_slot = solid_slot_->cview();
         m.slot_object = object_.view().data();
-        m.object_diffusivity = object_diffusivity_.view().data();
+        m.objects = object_heat_.view().data();
+        m.solid_slots = ibp_count_ + sbp_count_;
     }
 
     // The force on each object's IBPs in the last step (N, summed in double on the host),
@@ -360,7 +362,7 @@ class SolidBodies {
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
-               object_ibp_begin_.bytes() + object_velocity_.bytes() + object_diffusivity_.bytes();
+               object_ibp_begin_.bytes() + object_velocity_.bytes() + object_heat_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -495,7 +497,7 @@ class SolidBodies {
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
     DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
-    DeviceArray<Real> object_diffusivity_;         // per object, α (heat conduction only)
+    DeviceArray<HeatMaterial> object_heat_;        // per object, its thermal properties (heat conduction only)
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
 };
 

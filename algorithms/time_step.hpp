@@ -134,19 +134,13 @@ class BackendSimulation final : public Simulation {
             if (solids_.active() && !has_solid_volumes_)  // no fluid: the solids' volumes are the heat's own
                 compute_boundary_volumes(grid, store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
                                          ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
-            HeatMaterials materials;
-            materials.type = store_.type.cview();
-            materials.density = store_.density.cview();
-            materials.boundary_volume = boundary_volume_.cview();
-            materials.fluid_diffusivity = params_.heat.fluid_diffusivity;
-            materials.fluid_mass = fluid_.mass;
-            solids_.describe_heat(materials);
-            if (use_lists_)
-                heat_.step(lists_.view(), grid, fluid_count, ranges_.solid_end, store_.position.cview(), materials,
-                           temperature_->view(), dt, fluid_.kernel);
-            else
-                heat_.step(grid, grid, fluid_count, ranges_.solid_end, store_.position.cview(), materials,
-                           temperature_->view(), dt, fluid_.kernel);
+            const HeatMaterials materials = heat_materials();
+            heat_content_ = use_lists_ ? heat_.step(lists_.view(), grid, fluid_count, ranges_.solid_end,
+                                                    store_.position.cview(), materials, temperature_->view(), dt,
+                                                    fluid_.kernel)
+                                       : heat_.step(grid, grid, fluid_count, ranges_.solid_end,
+                                                    store_.position.cview(), materials, temperature_->view(), dt,
+                                                    fluid_.kernel);
             timers_.stop(kHeat);
         }
 
@@ -219,6 +213,7 @@ class BackendSimulation final : public Simulation {
         fill_report(dt, iterations, error, fluid_count, motion);
         report_.retries = retries;
         report_.heat_substeps = has_heat_ ? heat_.last_substeps() : 0;
+        report_.heat_content = has_heat_ ? heat_content_ : 0.0;
         report_.diverged = outcome == PcisphOutcome::kDiverged;
         report_.unconverged = outcome == PcisphOutcome::kOutOfIterations;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
@@ -247,6 +242,7 @@ class BackendSimulation final : public Simulation {
                backend_scratch_bytes();
     }
     double time() const override { return time_; }
+    int heat_substeps_needed(double dt) const override { return has_heat_ ? heat_.substeps_needed(dt) : 0; }
     std::string backend_name() const override { return kBackendName; }
     std::string device_name() const override { return device_description(); }
     std::vector<std::array<double, 3>> fluid_force_on_solids() const override { return solids_.object_forces(); }
@@ -352,6 +348,19 @@ class BackendSimulation final : public Simulation {
         }
     }
 
+    // Where the heat stage finds each particle's material and volume (heat.hpp).
+    HeatMaterials heat_materials() const {
+        HeatMaterials m;
+        m.type = store_.type.cview();
+        m.density = store_.density.cview();
+        m.boundary_volume = boundary_volume_.cview();
+        m.fluid = HeatMaterial{params_.heat.fluid_diffusivity, params_.heat.fluid_capacity};
+        m.fluid_mass = fluid_.mass;
+        m.rest_density = fluid_.rest_density;
+        solids_.describe_heat(m);
+        return m;
+    }
+
     void report_non_finite(std::uint32_t index, const char* what = "fluid particle") const {
         std::uint32_t scene_index = 0;
         Vec3 x{0, 0, 0}, v{0, 0, 0};
@@ -405,6 +414,7 @@ class BackendSimulation final : public Simulation {
     bool has_heat_ = false;                     // heat conduction (heat.hpp)
     DeviceArray<Real>* temperature_ = nullptr;  // its store field
     HeatConduction heat_;
+    double heat_content_ = 0;  // after the last step's heat stage, J
     ParticleCounts counts_;
     long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
     double time_ = 0;
@@ -475,10 +485,16 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
         }
         if (!(params_.heat.fluid_diffusivity >= 0) || !std::isfinite(double(params_.heat.fluid_diffusivity)))
             throw InputError("simulation setup: the fluid's thermal diffusivity must be finite and >= 0");
-        for (const SolidSetup& solid : setup.solids)
+        if (!(params_.heat.fluid_capacity > 0) || !std::isfinite(double(params_.heat.fluid_capacity)))
+            throw InputError("simulation setup: the fluid's heat capacity must be finite and > 0");
+        for (const SolidSetup& solid : setup.solids) {
             if (!(solid.thermal_diffusivity >= 0) || !std::isfinite(double(solid.thermal_diffusivity)))
                 throw InputError("simulation setup: solid \"" + solid.name +
                                  "\" has a thermal diffusivity that is not finite and >= 0");
+            if (!(solid.heat_capacity > 0) || !std::isfinite(double(solid.heat_capacity)))
+                throw InputError("simulation setup: solid \"" + solid.name +
+                                 "\" has a heat capacity that is not finite and > 0");
+        }
         if (params_.heat.max_substeps < 1)
             throw InputError("simulation setup: heat conduction needs max_substeps >= 1");
         temperature_ = &store_.add<Real>("temperature", FieldLife::kPersistent);
@@ -590,6 +606,15 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (solids_.active()) solids_.update_slot_map(store_);
     if (use_lists_)
         lists_.build(grid_.view(), ranges_.fluid_end, store_.position.cview(), fluid_.kernel.h, neighbor_count_->view());
+    // The heat's sub-steps from the particles as they start: the solids' g can exceed a fluid
+    // lattice's (heat.hpp, calibrate).
+    if (has_heat_) {
+        if (solids_.active())
+            compute_boundary_volumes(grid_.view(), store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
+                                     ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+        heat_.calibrate(grid_.view(), ranges_.fluid_end, ranges_.solid_end, store_.position.cview(), heat_materials(),
+                        fluid_.kernel);
+    }
 
     // The reductions a step reads back (the density error, the motion summaries) make their
     // workspaces on first use: on a GPU a device result, a pinned host slot and CUB's temporary
@@ -670,6 +695,9 @@ void BackendSimulation<Kernel>::load_state(const StateArchive& in) {
                          "written for another scene or by another version");
     // The lists' row counts only size the next layout: a checkpoint from a backend without lists
     // starts them from 0, as the first step of a run does (one second fill).
+    if (temperature_ && !in.has("store.temperature"))
+        throw InputError("checkpoint: it holds no temperatures, and this scene conducts heat (heat.enabled); it was "
+                         "written for another scene");
     store_.load(in, {"neighbor_count"});
     if (neighbor_count_ && !in.has("store.neighbor_count")) neighbor_count_->fill(0);
     solids_.load(in);

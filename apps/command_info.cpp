@@ -43,6 +43,8 @@ int command_info(int argc, char** argv) {
     const SolverParams& solver = scene.params.solver;
     const bool cfl = solver.dt_mode == TimeStepMode::kCfl;
     const Real wall_gap = scene.walls ? scene.wall_gap() : Real(0);
+    const std::string heat_warning =
+        heat_substeps_warning(probe->heat_substeps_needed(double(solver.dt)), scene.params.heat.max_substeps);
     const long frames = scene.writes_vtu() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
 
     if (flag_option(args, "json")) {
@@ -56,7 +58,7 @@ int command_info(int argc, char** argv) {
         j["fluid_carved"] = carved_fluid;
         if (scene.walls) j["wall_gap_m"] = wall_gap;  // the first wall layer's distance outside the faces
         j["warnings"] = SceneJson::array();
-        for (const std::string& warning : {scene.kernel_warning(), scene.heat_warning()})
+        for (const std::string& warning : {scene.kernel_warning(), heat_warning})
             if (!warning.empty()) j["warnings"].push_back(warning);
         j["backend"] = backend;
         j["device_bytes"] = bytes;
@@ -184,17 +186,19 @@ int command_info(int argc, char** argv) {
         if (with_tension)
             std::printf("            interface tension (Eq. 9) between the fluid and %ld object(s)\n", with_tension);
     }
-    // Heat conduction (docs/heat.md): who conducts, and the Fourier number that sets its sweeps.
+    // Heat conduction (docs/heat.md): who conducts, and the Fourier number that sets its sub-steps.
     if (scene.params.heat.enabled) {
-        std::printf("heat        conduction on (heat.enabled) among the fluid and %ld moving object(s); walls, "
-                    "static boxes and static objects are adiabatic; Fourier number alpha dt / r0^2 up to %.3g at the "
-                    "largest step: %d sub-step(s) a step (at most %d)\n",
-                    moving_objects,
+        const std::string who = (scene.fluid_blocks.empty() ? std::string("") : std::string("the fluid and ")) +
+                                std::to_string(moving_objects) + " moving object(s)";
+        std::printf("heat        conduction on (heat.enabled) among %s; walls, static boxes and static objects are "
+                    "adiabatic; Fourier number alpha dt / r0^2 up to %.3g at the largest step: %d sub-step(s) a "
+                    "step (at most %d)\n",
+                    who.c_str(),
                     scene.largest_heat_diffusivity() * double(solver.dt) / (double(f.spacing) * double(f.spacing)),
-                    std::min(scene.heat_substeps_needed(), scene.params.heat.max_substeps),
+                    std::min(probe->heat_substeps_needed(double(solver.dt)), scene.params.heat.max_substeps),
                     scene.params.heat.max_substeps);
     }
-    for (const std::string& warning : {scene.kernel_warning(), scene.heat_warning()})
+    for (const std::string& warning : {scene.kernel_warning(), heat_warning})
         if (!warning.empty()) std::printf("warning     %s\n", warning.c_str());
     return 0;
 }

@@ -210,7 +210,7 @@ int command_run(int argc, char** argv) {
         frames->set_objects(setup.solids);
         if (continues_directory) frames->keep_earlier(frame_times);
     }
-    StatsTable stats(sim->stage_names());
+    StatsTable stats(sim->stage_names(), scene.params.heat.enabled);
     if (continues_directory) stats.keep_earlier_rows(stats_rows_up_to(stats_path, stats.header(), resume->step));
 
     RunSummary summary;
@@ -231,7 +231,9 @@ int command_run(int argc, char** argv) {
         summary.simulated_time = resume->time;
     }
 
-    for (const std::string& warning : {scene.kernel_warning(), scene.heat_warning()}) {
+    const std::string heat_warning =
+        heat_substeps_warning(sim->heat_substeps_needed(double(scene.params.solver.dt)), scene.params.heat.max_substeps);
+    for (const std::string& warning : {scene.kernel_warning(), heat_warning}) {
         if (warning.empty()) continue;
         std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
         summary.warnings.push_back(warning);

@@ -142,8 +142,8 @@ void FrameWriter::write_objects(int index, const HostParticles& p) const {
     }
 }
 
-StatsTable::StatsTable(std::vector<std::string> stage_names)
-    : stages_(std::move(stage_names)), stage_ms_(stages_.size()) {}
+StatsTable::StatsTable(std::vector<std::string> stage_names, bool heat)
+    : stages_(std::move(stage_names)), heat_(heat), stage_ms_(stages_.size()) {}
 
 void StatsTable::add(const StepReport& r) {
     char buffer[256];
@@ -151,6 +151,10 @@ void StatsTable::add(const StepReport& r) {
                   r.iterations, r.density_error_avg, r.density_error_max, r.max_speed, r.kinetic_energy,
                   r.lost_particles, r.retries, r.diverged ? 1 : 0, r.unconverged ? 1 : 0);
     csv_rows_ += buffer;
+    if (heat_) {
+        std::snprintf(buffer, sizeof buffer, ",%.9g", r.heat_content);
+        csv_rows_ += buffer;
+    }
     for (std::size_t s = 0; s < stages_.size(); ++s) {
         const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
         std::snprintf(buffer, sizeof buffer, ",%.4f", ms);
@@ -172,6 +176,7 @@ std::string StatsTable::header() const {
     std::string h =
         "step,time,dt,iterations,density_error_avg,density_error_max,max_speed,kinetic_energy,lost_particles,"
         "dt_retries,diverged,unconverged";
+    if (heat_) h += ",heat_content";
     for (const auto& s : stages_) h += ",ms_" + s;
     return h + ",ms_total";
 }

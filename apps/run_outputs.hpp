@@ -54,7 +54,8 @@ class FrameWriter {
 // atomically (so stats.csv is always whole). The numbers the summary needs are kept as columns.
 class StatsTable {
    public:
-    explicit StatsTable(std::vector<std::string> stage_names);
+    // `heat`: the scene conducts heat, and the table has a heat_content column.
+    explicit StatsTable(std::vector<std::string> stage_names, bool heat = false);
     void add(const StepReport& report);
     // Rows of the run this one resumes (stats_rows_up_to), written before this run's; the figures
     // below cover this run's rows only.
@@ -79,6 +80,7 @@ class StatsTable {
 
    private:
     std::vector<std::string> stages_;
+    bool heat_ = false;
     std::string earlier_rows_;                   // a resumed run's rows from before its checkpoint
     std::string csv_rows_;                       // every row so far, as written to stats.csv
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]

@@ -13,7 +13,6 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "algorithms/pcisph_delta.hpp"
 #include "backend/errors.hpp"
 #include "sampling/wall_gap.hpp"
 
@@ -376,9 +375,10 @@ void read_fluid(Section s, Scene& scene) {
     f.viscosity = Real(s.number("viscosity", 0.0, Range::non_negative()));
     f.wall_viscosity = Real(s.number("wall_viscosity", 0.0, Range::non_negative()));
     // With heat.enabled only (docs/heat.md): the fluid blocks' default temperature, and the
-    // fluid's thermal diffusivity (water's at 20 °C by default).
+    // fluid's thermal diffusivity and heat capacity per volume (water's at 20 °C by default).
     scene.fluid_temperature = Real(s.number("temperature", 20.0, kTemperatureRange));
     scene.params.heat.fluid_diffusivity = Real(s.number("thermal_diffusivity", 1.43e-7, Range::non_negative()));
+    scene.params.heat.fluid_capacity = Real(s.number("heat_capacity", 4.18e6, Range::positive()));
     s.finish();
 }
 
@@ -549,6 +549,7 @@ void read_objects(Section& root, Scene& scene) {
         o.temperature = Real(s.number("temperature", double(scene.fluid_temperature), kTemperatureRange));
         o.thermal_diffusivity = Real(s.number("thermal_diffusivity", double(scene.params.heat.fluid_diffusivity),
                                               Range::non_negative()));
+        o.heat_capacity = Real(s.number("heat_capacity", double(scene.params.heat.fluid_capacity), Range::positive()));
         read_object_lsm(s.object("lsm"), o);
         read_object_pinned(s.object("pinned"), o);
         scene.objects.push_back(o);
@@ -759,24 +760,13 @@ double Scene::largest_heat_diffusivity() const {
     return largest;
 }
 
-int Scene::heat_substeps_needed() const {
-    if (!params.heat.enabled) return 0;
-    const FluidParams& f = params.fluid;
-    const double d_per_dt = with_kernel(f.kernel, f.support_radius, [&](const auto& kernel) {
-        return heat_d_per_dt(prototype_sums(kernel, double(f.spacing), 3), largest_heat_diffusivity());
-    });
-    const double needed = std::ceil(d_per_dt * double(params.solver.dt));
-    return needed < 1 ? 1 : needed > 1e9 ? 1000000000 : static_cast<int>(needed);
-}
-
-std::string Scene::heat_warning() const {
-    const int needed = heat_substeps_needed();
-    if (needed <= params.heat.max_substeps) return "";
+std::string heat_substeps_warning(int needed, int max_substeps) {
+    if (needed <= max_substeps) return "";
     char text[300];
     std::snprintf(text, sizeof text,
                   "the largest step needs %d heat sub-steps, more than heat.max_substeps (%d): there the heat "
-                  "spreads more slowly than the diffusivities say (docs/heat.md)",
-                  needed, params.heat.max_substeps);
+                  "spreads more slowly than the diffusivities say, and is conserved only approximately (docs/heat.md)",
+                  needed, max_substeps);
     return text;
 }
 

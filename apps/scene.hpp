@@ -42,6 +42,7 @@ struct SceneObject {
     Real interface_tension = 0;  // η, Eq. 9 (elastic and rigid objects)
     Real temperature = 20;                    // °C, with heat conduction (fluid.temperature by default)
     Real thermal_diffusivity = Real(1.43e-7); // m²/s (fluid.thermal_diffusivity by default)
+    Real heat_capacity = Real(4.18e6);        // ρc, J/(m³ K) (fluid.heat_capacity by default)
     enum class Pin { kNone, kBox, kHalfSpace } pin = Pin::kNone;
     Vec3 pin_min{}, pin_max{};          // box
     Vec3 pin_point{}, pin_normal{};     // half-space: IBPs with (x - point)·normal < 0 are pinned
@@ -80,12 +81,13 @@ struct Scene {
     // the cubic spline wider than 2.25 r0 (docs/solver.md, "Kernels").
     std::string kernel_warning() const;
     // Heat conduction (docs/heat.md): the largest thermal diffusivity among the fluid and the
-    // moving objects, the sub-steps the largest step needs (0 without heat), and a warning when
-    // that is more than heat.max_substeps ("" otherwise).
+    // moving objects.
     double largest_heat_diffusivity() const;
-    int heat_substeps_needed() const;
-    std::string heat_warning() const;
 };
+
+// A warning when the largest step needs more heat sub-steps than heat.max_substeps allows ("" when
+// it does not; Simulation::heat_substeps_needed gives `needed`).
+std::string heat_substeps_warning(int needed, int max_substeps);
 
 // The built-in default scene (scenes/dam_break.json, embedded at configure time).
 const char* default_scene_text();

@@ -217,6 +217,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         solid.wall_friction = o.wall_friction;
         solid.interface_tension = o.interface_tension;
         solid.thermal_diffusivity = o.thermal_diffusivity;
+        solid.heat_capacity = o.heat_capacity;
         std::function<bool(const Vec3&)> pinned;
         if (o.pin == SceneObject::Pin::kBox) {
             const Vec3 lo = o.pin_min, hi = o.pin_max;

@@ -45,9 +45,12 @@ TEST_CASE("run: frames carry each particle's temperature when heat conduction is
     CAPTURE(r.err);
     REQUIRE(r.code == 0);
     CHECK(contains(slurp(hot + "/frames/particles_00000.vtu"), "Name=\"temperature\""));
-    CHECK(contains(slurp(hot + "/stats.csv").substr(0, 400), "ms_heat"));
+    const std::string header = slurp(hot + "/stats.csv").substr(0, 400);
+    CHECK(contains(header, "ms_heat"));
+    CHECK(contains(header, "unconverged,heat_content,ms_"));
     REQUIRE(run("run " + scene + " --steps 1 --quiet --out " + plain).code == 0);
     CHECK(!contains(slurp(plain + "/frames/particles_00000.vtu"), "temperature"));
+    CHECK(!contains(slurp(plain + "/stats.csv").substr(0, 400), "heat_content"));
 }
 
 TEST_CASE("bad input: heat keys") {
@@ -57,4 +60,6 @@ TEST_CASE("bad input: heat keys") {
     check_rejected(run("info " + scene + " --set fluid.temperature=-300"), {"fluid.temperature", "-273.15"});
     check_rejected(run("info " + scene + " --set fluid_blocks.0.temperature=hot"), {"fluid_blocks[0].temperature"});
     check_rejected(run("info " + scene + " --set objects.0.thermal_diffusivity=-1"), {"objects[0].thermal_diffusivity"});
+    check_rejected(run("info " + scene + " --set fluid.heat_capacity=0"), {"fluid.heat_capacity", "> 0"});
+    check_rejected(run("info " + scene + " --set objects.0.heat_capacity=-5"), {"objects[0].heat_capacity"});
 }
