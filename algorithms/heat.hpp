@@ -7,20 +7,21 @@
 // W' and gives a weight that is never negative (Cleary & Monaghan's 1999 form for conduction
 // between materials), written per particle as
 //
-//   M_i dT_i/dt = V_i Σ_j c_ij (T_j - T_i),   c_ij = 2 s k_ij V_j F_ij,   F_ij = -W'(r_ij) / r_ij.
+//   M_i dT_i/dt = V_i Σ_j c_ij (T_j - T_i),   c_ij = 2 s k_ij V_j F_ij γ_ij,   F_ij = -W'(r_ij) / r_ij.
 //
-// C = ρc is the material's heat capacity per volume and k = α C its conductivity (the fluid's, or
-// the particle's object's: the scene gives the diffusivity α and C); k_ij = 2 k_i k_j / (k_i + k_j)
-// the pair's (the two half-spacings in series: right at an interface, and k for one material);
-// V = m/ρ0 for fluid (an incompressible fluid's volume: m/ρ with PCISPH's ρ, which a free surface's
-// missing neighbours lower, made a fluid bar conduct 6% fast) and the Akinci volume V_b, this
-// step's, for a solid's particles; M_i = V⁰_i C_i the particle's heat capacity, fixed: V⁰ is m/ρ0
-// for fluid and a solid particle's V_b as the scene starts (V_b changes as solids deform or pass a
-// wall or one another; a heat content taken with this step's volumes drifted by 0.3% in a pool
-// settling around a box, with m/ρ for the fluid). s is
-// the lattice factor that makes the sum exact on a regular lattice at spacing r0
-// (pcisph_delta.hpp, laplacian_moment: at h = 2 r0 the raw sum is 2% fast for the cubic spline).
-// The heat Σ_i M_i T_i is conserved: V_i c_ij = V_j c_ji, while every particle's update stays
+// - C = ρc is the material's heat capacity per volume and k = α C its conductivity (the fluid's,
+//   or the particle's object's: the scene gives the diffusivity α and C); k_ij = 2 k_i k_j /
+//   (k_i + k_j) the pair's (two half-spacings in series: right at an interface, k for one material).
+// - V = m/ρ0 for fluid (an incompressible fluid's volume) and this step's Akinci volume V_b for a
+//   solid's particle. M_i = V⁰_i C_i is the particle's heat capacity, fixed for the run: V⁰ is m/ρ0
+//   for fluid and a solid particle's V_b as the scene starts (a heat content taken with each
+//   step's volumes, m/ρ for the fluid, drifted by 0.3% in a pool settling around a box).
+// - γ_ij = (γ_i + γ_j)/2, γ = ρ0/ρ for fluid (its PCISPH density, clamped to [1, 3]) and 1 for a
+//   solid's particle, makes up for the neighbours missing at a free surface (without it a fluid
+//   bar 9 r0 across conducted 6% slow; with m/ρ as the volumes instead, 6% fast).
+// - s makes the sum exact on a regular lattice at spacing r0 (pcisph_delta.hpp, laplacian_moment:
+//   at h = 2 r0 the raw sum is 2% fast for the cubic spline).
+// The heat Σ_i M_i T_i is conserved, V_i c_ij = V_j c_ji, while every particle's update stays
 // within the limit below.
 //
 // Time: explicit sub-steps, as many as keep g = δt V_i Σ_j c_ij / M_i at most 1 for every particle as
@@ -34,7 +35,7 @@
 // METHOD.md's backward Euler (one pass per step, stable at any Δt) was built first, as Jacobi
 // sweeps of the implicit system: one sweep diffuses at 1/(1 + D) of the true rate (0.56 at a
 // Fourier number α Δt / r0² of 0.2, 0.21 at 1), and reaching 5% took 4 sweeps at 0.2 and 28 at 2
-// (then 11% slow). Explicit sub-steps were within 2% of the true rate at every Fourier number
+// (then about 11% slow). Explicit sub-steps are within 1% of the true rate at every Fourier number
 // tried, in 1 pass at 0.2 and 9 at 2 (tests/core/test_heat.cpp, docs/heat.md).
 #pragma once
 #include <algorithm>

@@ -64,6 +64,8 @@ int command_info(int argc, char** argv) {
         j["device_bytes"] = bytes;
         j["bytes_per_particle"] = bytes_per_particle;
         j["stages"] = stages;
+        if (scene.params.heat.enabled)  // the sub-steps the largest step needs, before heat.max_substeps
+            j["heat_substeps_needed"] = probe->heat_substeps_needed(double(solver.dt));
         j["frames"] = frames;
         j["scene"] = scene.resolved;
         std::printf("%s\n", j.dump(2, ' ', false, SceneJson::error_handler_t::replace).c_str());

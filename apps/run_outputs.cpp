@@ -154,6 +154,8 @@ void StatsTable::add(const StepReport& r) {
     if (heat_) {
         std::snprintf(buffer, sizeof buffer, ",%.9g", r.heat_content);
         csv_rows_ += buffer;
+        if (total_ms_.empty()) heat_first_ = r.heat_content;
+        heat_last_ = r.heat_content;
     }
     for (std::size_t s = 0; s < stages_.size(); ++s) {
         const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
@@ -272,6 +274,13 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     j["retried_steps"] = stats.retried_steps();
     j["diverged_steps"] = stats.diverged_steps();
     j["unconverged_steps"] = stats.unconverged_steps();
+    // Heat conduction: the heat content (stats.csv) should stay constant; its change over the run.
+    if (stats.has_heat() && stats.rows() > 0) {
+        const double first = stats.heat_content_first(), last = stats.heat_content_last();
+        j["heat_content"] = {{"after_first_step", finite_or_null(first)},
+                             {"at_end", finite_or_null(last)},
+                             {"relative_change", finite_or_null(first != 0 ? (last - first) / std::fabs(first) : 0.0)}};
+    }
     j["device_bytes"] = run.device_bytes;
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;

@@ -77,10 +77,15 @@ class StatsTable {
     // steps whose last PCISPH try ran out of iterations above the tolerance
     long unconverged_steps() const { return unconverged_steps_; }
     double sum_total_ms() const;
+    // With heat conduction: the heat content after this run's first step and after its last.
+    bool has_heat() const { return heat_; }
+    double heat_content_first() const { return heat_first_; }
+    double heat_content_last() const { return heat_last_; }
 
    private:
     std::vector<std::string> stages_;
     bool heat_ = false;
+    double heat_first_ = 0, heat_last_ = 0;
     std::string earlier_rows_;                   // a resumed run's rows from before its checkpoint
     std::string csv_rows_;                       // every row so far, as written to stats.csv
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]

@@ -2,6 +2,8 @@
 // and the temperature in the frames. The physics is checked in tests/core/test_heat.cpp.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include "cli_helpers.hpp"
 
 using namespace cli_test;
@@ -23,6 +25,7 @@ TEST_CASE("info: heat conduction is a stage after PCISPH when the scene asks, an
     REQUIRE(heat != with.end());
     CHECK(heat > pcisph);  // the step's length is settled by then
     CHECK(on["scene"]["heat"]["enabled"] == true);
+    CHECK(on["heat_substeps_needed"].get<int>() >= 1);
     CHECK(on["scene"]["objects"][0]["temperature"] == 80.0);
     CHECK(on["scene"]["fluid_blocks"][0]["temperature"] == 10.0);  // fluid.temperature is the blocks' default
     CHECK(contains(run("info " + scene + heated_box_options(true)).out, "conduction on (heat.enabled)"));
@@ -34,6 +37,7 @@ TEST_CASE("info: heat conduction is a stage after PCISPH when the scene asks, an
     const nlohmann::json capped =
         info_json(scene, heated_box_options(true) + " --set heat.max_substeps=1 --set fluid.thermal_diffusivity=0.5");
     REQUIRE(capped["warnings"].size() == 1);
+    CHECK(capped["heat_substeps_needed"].get<int>() > 1);
     CHECK(contains(capped["warnings"][0].get<std::string>(), "heat.max_substeps (1)"));
     CHECK(info_json(scene, heated_box_options(true))["warnings"].empty());
 }
@@ -48,9 +52,14 @@ TEST_CASE("run: frames carry each particle's temperature when heat conduction is
     const std::string header = slurp(hot + "/stats.csv").substr(0, 400);
     CHECK(contains(header, "ms_heat"));
     CHECK(contains(header, "unconverged,heat_content,ms_"));
+    const nlohmann::json summary = read_json(hot + "/summary.json");
+    REQUIRE(summary.contains("heat_content"));
+    CHECK(std::fabs(summary["heat_content"]["relative_change"].get<double>()) < 1e-5);
+    CHECK(summary["heat_content"]["at_end"].get<double>() > 0);
     REQUIRE(run("run " + scene + " --steps 1 --quiet --out " + plain).code == 0);
     CHECK(!contains(slurp(plain + "/frames/particles_00000.vtu"), "temperature"));
     CHECK(!contains(slurp(plain + "/stats.csv").substr(0, 400), "heat_content"));
+    CHECK(!read_json(plain + "/summary.json").contains("heat_content"));
 }
 
 TEST_CASE("bad input: heat keys") {

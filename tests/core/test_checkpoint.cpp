@@ -141,7 +141,7 @@ TEST_CASE("a saved state that does not fit the setup is refused, naming what dif
     CHECK(load_message(setup, resized).find("'time'") != std::string::npos);
 }
 
-TEST_CASE("a state saved on CUDA continues on OpenMP, and the other way round") {
+TEST_CASE("CUDA: a state saved on CUDA continues on OpenMP, and the other way round") {
     if (!cuda_backend_info().available) {
         MW_SKIP(cuda_backend_info().description);
         return;
