@@ -95,10 +95,10 @@ MW_INLINE HeatSums sum_conducting(const NeighborListView& lists, std::size_t i, 
     return sums;
 }
 
-// A particle's conduction data for a step: its volume V, conductivity k, and V/M (M its heat
-// capacity, J/K).
+// A particle's conduction data for a step: its volume V, conductivity k, heat capacity M (J/K)
+// and free-surface factor γ.
 struct HeatParticle {
-    Real volume = 0, conductivity = 0, volume_per_capacity = 0;
+    Real volume = 0, conductivity = 0, capacity = 1;
     Real deficiency = 1;  // γ
 };
 
@@ -133,7 +133,7 @@ void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t cou
             const Real c = heat_pair(xi, k_i, gamma_i, j, end, position, particle, kernel, read);
             return HeatSums{c, c * in[read]};
         });
-        const Real a_i = dt_times_scale * particle[i].volume_per_capacity;
+        const Real a_i = dt_times_scale * particle[i].volume / particle[i].capacity;
         const Real g = a_i * sums.weight;
         const Real share = g > Real(1) ? Real(1) / g : Real(1);
         out[i] = in[i] + share * (a_i * sums.weighted - g * in[i]);
@@ -143,30 +143,27 @@ void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t cou
 // The heat content Σ M T of particles [0, count), J (T in °C), in double.
 inline double heat_content(std::size_t count, View<const HeatParticle> particle, View<const Real> temperature) {
     return transform_reduce("heat_content", count, 0.0, SumOp{}, [=] MW_HD(std::size_t i) {
-        const double v_per_m = double(particle[i].volume_per_capacity);
-        return v_per_m > 0 ? double(particle[i].volume) / v_per_m * double(temperature[i]) : 0.0;
+        return double(particle[i].capacity) * double(temperature[i]);
     });
 }
 
 // The heat stage's own buffers and its sub-steps.
 class HeatConduction {
    public:
-    // `moving`: the store's moving particles (the most a pass covers); `lattice_scale`: s above;
-    // `d_per_dt`: g / Δt of a full lattice of the most diffusive material (pcisph_delta.hpp,
-    // heat_d_per_dt), raised by calibrate().
-    void init(std::size_t moving, int max_substeps, double lattice_scale, double d_per_dt) {
+    // `moving`: the store's moving particles (the most a pass covers); `lattice_scale`: s above.
+    // calibrate() then sets the sub-steps' scale.
+    void init(std::size_t moving, int max_substeps, double lattice_scale) {
         max_substeps_ = std::max(1, max_substeps);
         lattice_scale_ = lattice_scale;
-        d_per_dt_ = d_per_dt;
         particle_.assign(moving, HeatParticle{});
         other_.assign(moving, Real(0));
         solid_rest_volume_.assign(1, Real(0));  // calibrate() sizes it
         heat_content(moving, particle_.cview(), other_.cview());  // its reduction workspace, before the first step
     }
     // At set-up, with the scene's first volumes and grid: each solid particle's V⁰ (its V_b now),
-    // and the largest g / Δt over particles [0, solid_end), if above the lattice's (the solids'
-    // overlapping surface and inner particles, and the pairs across materials). One neighbour
-    // pass and a reduction.
+    // and the largest g / Δt over particles [0, solid_end) (4.33 α / r0² in a fluid at rest for the
+    // cubic spline at h = 2 r0; the solids' overlapping surface and inner particles reach 1.6 times
+    // their material's). One neighbour pass and a reduction.
     template <class Kernel>
     void calibrate(const GridView& grid, std::size_t fluid_end, std::size_t solid_end, View<const Vec3> position,
                    const HeatMaterials& m, Kernel kernel) {
@@ -184,18 +181,13 @@ class HeatConduction {
         const Real largest = transform_reduce("heat_calibrate", solid_end, Real(0), MaxOp{}, [=] MW_HD(std::size_t i) {
             const Vec3 xi = position[i];
             const Real k_i = particle[i].conductivity, gamma_i = particle[i].deficiency;
-            Real weight = 0;
-            grid.for_each_fluid(xi, [&](std::uint32_t j) {
+            const HeatSums sums = sum_conducting(grid, i, xi, [&](std::uint32_t j) {
                 std::uint32_t read = 0;
-                weight += heat_pair(xi, k_i, gamma_i, j, solid_end, position, particle, kernel, read);
+                return HeatSums{heat_pair(xi, k_i, gamma_i, j, solid_end, position, particle, kernel, read), Real(0)};
             });
-            grid.for_each_solid(xi, [&](std::uint32_t j) {
-                std::uint32_t read = 0;
-                weight += heat_pair(xi, k_i, gamma_i, j, solid_end, position, particle, kernel, read);
-            });
-            return two_s * particle[i].volume_per_capacity * weight;
+            return two_s * particle[i].volume / particle[i].capacity * sums.weight;
         });
-        d_per_dt_ = std::max(d_per_dt_, double(largest));
+        d_per_dt_ = double(largest);
     }
     // The sub-steps a step of dt needs (g <= 1 each), and takes (at most max_substeps).
     int substeps_needed(double dt) const {
@@ -204,20 +196,21 @@ class HeatConduction {
     }
     int substeps_for(double dt) const { return std::min(substeps_needed(dt), max_substeps_); }
     int last_substeps() const { return last_substeps_; }
+    double last_content() const { return last_content_; }  // the heat after the last step, J
     std::size_t bytes() const { return particle_.bytes() + other_.bytes() + solid_rest_volume_.bytes(); }
 
     // Advances `temperature` (a store field) by dt over the fluid [0, fluid_end), whose rows come
     // from `fluid_rows` (this step's lists, or the grid), and the moving solids' particles
     // [fluid_end, solid_end) (the grid). The sub-steps alternate between the store's field and
-    // other_, starting where an odd or even count ends in the store. Returns the heat content
-    // after the step (a reduction read back: the run's conservation check, stats.csv).
+    // other_, starting where an odd or even count ends in the store. Then the heat content (a
+    // reduction read back: the run's conservation check, stats.csv).
     template <class Neighbors, class Kernel>
-    double step(const Neighbors& fluid_rows, const GridView& grid, std::size_t fluid_end, std::size_t solid_end,
+    void step(const Neighbors& fluid_rows, const GridView& grid, std::size_t fluid_end, std::size_t solid_end,
                 View<const Vec3> position, const HeatMaterials& m, View<Real> temperature, Real dt, Kernel kernel) {
         const int substeps = substeps_for(double(dt));
         last_substeps_ = substeps;
-        if (solid_end == 0) return 0;
-        describe_particles(solid_end, m, temperature);
+        if (solid_end == 0) return;
+        describe_particles(solid_end, m, substeps % 2 == 1 ? View<const Real>(temperature) : View<const Real>{});
         const Real a = static_cast<Real>(2 * lattice_scale_ * double(dt) / substeps);
         // An odd count starts from the copy in other_, an even one from the store: the last lands there.
         View<Real> in = substeps % 2 == 1 ? other_.view() : temperature;
@@ -230,11 +223,11 @@ class HeatConduction {
                              a, kernel);
             std::swap(in, out);
         }
-        return heat_content(solid_end, particle_.cview(), temperature);
+        last_content_ = heat_content(solid_end, particle_.cview(), temperature);
     }
 
-    // Each conducting particle's volume, conductivity and V/M for this step, and a copy of
-    // `temperature` (when given) in other_. Public only because nvcc allows no device lambda in a
+    // Each conducting particle's volume, conductivity, heat capacity and γ for this step, and a
+    // copy of `temperature` (when given: an odd count of sub-steps starts from it) in other_. Public only because nvcc allows no device lambda in a
     // private member function.
     void describe_particles(std::size_t solid_end, const HeatMaterials& m, View<const Real> temperature) {
         const View<Real> other = other_.view();
@@ -251,7 +244,7 @@ class HeatConduction {
             p.volume = fluid ? rest_volume : m.boundary_volume[i];
             const Real gamma = fluid ? m.rest_density / m.density[i] : Real(1);
             p.deficiency = gamma < Real(1) ? Real(1) : gamma > Real(3) ? Real(3) : gamma;
-            p.volume_per_capacity = rest_volume > Real(0) ? p.volume / (rest_volume * material.capacity) : Real(0);
+            p.capacity = rest_volume * material.capacity;
             p.conductivity = material.diffusivity * material.capacity;
             particle[i] = p;
         });
@@ -262,6 +255,7 @@ class HeatConduction {
     double lattice_scale_ = 1;
     double d_per_dt_ = 0;  // the largest g / Δt
     int last_substeps_ = 0;
+    double last_content_ = 0;
     DeviceArray<HeatParticle> particle_;  // per moving particle, this step's
     DeviceArray<Real> other_;             // the sub-steps' second buffer
     DeviceArray<Real> solid_rest_volume_;  // per solid slot (IBPs, SBPs), its V⁰

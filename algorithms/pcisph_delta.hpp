@@ -15,7 +15,6 @@ struct PrototypeSums {
     // Σ_j (-W'(r_j)/r_j) x_j² (one axis): Brookshaw's Laplacian on the lattice is this over Σ_j W
     // times the true one (heat.hpp rescales by its inverse).
     double laplacian_moment = 0;
-    double laplacian_weight = 0;  // Σ_j -W'(r_j)/r_j
 };
 
 // dimensions: 2 (lattice in the xy plane) or 3.
@@ -37,23 +36,15 @@ PrototypeSums prototype_sums(const Kernel& kernel, double spacing, int dimension
                 gy += g.y;
                 gz += g.z;
                 sums.sum_grad_sq += double(g.x) * g.x + double(g.y) * g.y + double(g.z) * g.z;
-                if (r > 0) {  // -W'(r)/r = |∇W| / r: the kernels fall monotonically
-                    const double f = double(norm(g)) / double(r);
-                    sums.laplacian_weight += f;
-                    sums.laplacian_moment += f * double(x.x) * double(x.x);
-                }
+                // -W'(r)/r = |∇W| / r: the kernels fall monotonically.
+                if (r > 0) sums.laplacian_moment += double(norm(g)) / double(r) * double(x.x) * double(x.x);
             }
     sums.grad_sum_sq = gx * gx + gy * gy + gz * gz;
     return sums;
 }
 
-// Heat conduction (heat.hpp): the factor s that makes Brookshaw's Laplacian exact on the lattice,
-// and D / Δt = 2 α s Σ_j V_j F_j of a full neighbourhood for diffusivity α, which sets the
-// sub-steps (D <= 1 each).
+// Heat conduction (heat.hpp): the factor s that makes Brookshaw's Laplacian exact on the lattice.
 inline double heat_lattice_scale(const PrototypeSums& sums) { return sums.sum_W / sums.laplacian_moment; }
-inline double heat_d_per_dt(const PrototypeSums& sums, double diffusivity) {
-    return 2 * diffusivity * sums.laplacian_weight / sums.laplacian_moment;
-}
 
 inline double pcisph_delta(const PrototypeSums& sums, double rest_density, double mass, double dt) {
     return rest_density * rest_density / (2.0 * dt * dt * mass * mass * (sums.grad_sum_sq + sums.sum_grad_sq));

@@ -97,8 +97,8 @@ struct SimulationParams {
         bool enabled = false;
         Real fluid_diffusivity = Real(1.43e-7);  // α of the fluid, m²/s (water at 20 °C)
         Real fluid_capacity = Real(4.18e6);      // ρc of the fluid, J/(m³ K) (water)
-        // Explicit sub-steps per step (heat.hpp): as many as the most diffusive material needs
-        // for stability on a full lattice, at most this.
+        // Explicit sub-steps per step (heat.hpp): as many as keep every particle's update a mean
+        // of its neighbours' temperatures as the scene starts, at most this.
         int max_substeps = 32;
     } heat;
     Vec3 gravity{0, -9.81f, 0};
@@ -186,7 +186,7 @@ struct StepReport {
     double solid_kinetic_energy = 0;  // J over the IBPs of moving solids
     double solid_max_speed = 0;       // m/s over the same
     int heat_substeps = 0;  // the heat stage's sub-steps this step (heat.hpp); 0 without it
-    double heat_content = 0;  // Σ V ρc T over the conducting particles after the step, J (T in °C); 0 without it
+    double heat_content = 0;  // Σ M T over the conducting particles after the step, J (T in °C; heat.hpp); 0 without it
     int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged or ran out of iterations
     bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
     bool unconverged = false;  // the last try ran out of iterations above η (or eta_max), without diverging

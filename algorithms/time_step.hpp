@@ -56,8 +56,7 @@ class BackendSimulation final : public Simulation {
         //    will meet them (pcisph.hpp, SolidLookahead: each soft object's mean velocity).
         if (has_solid_volumes_) {
             timers_.start(kSolidVolumes);
-            compute_boundary_volumes(grid, store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
-                                     ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+            compute_moving_solid_volumes(grid);
             if (predicts_solids_) lookahead_ = solids_.lookahead(store_, ranges_.solid_end);
             timers_.stop(kSolidVolumes);
         }
@@ -131,16 +130,15 @@ class BackendSimulation final : public Simulation {
         //     length is settled (PCISPH may have halved it) and nothing has moved yet.
         if (has_heat_) {
             timers_.start(kHeat);
-            if (solids_.active() && !has_solid_volumes_)  // no fluid: the solids' volumes are the heat's own
-                compute_boundary_volumes(grid, store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
-                                         ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+            // No fluid: the solids' volumes are the heat's own to compute.
+            if (solids_.active() && !has_solid_volumes_) compute_moving_solid_volumes(grid);
             const HeatMaterials materials = heat_materials();
-            heat_content_ = use_lists_ ? heat_.step(lists_.view(), grid, fluid_count, ranges_.solid_end,
-                                                    store_.position.cview(), materials, temperature_->view(), dt,
-                                                    fluid_.kernel)
-                                       : heat_.step(grid, grid, fluid_count, ranges_.solid_end,
-                                                    store_.position.cview(), materials, temperature_->view(), dt,
-                                                    fluid_.kernel);
+            if (use_lists_)
+                heat_.step(lists_.view(), grid, fluid_count, ranges_.solid_end, store_.position.cview(), materials,
+                           temperature_->view(), dt, fluid_.kernel);
+            else
+                heat_.step(grid, grid, fluid_count, ranges_.solid_end, store_.position.cview(), materials,
+                           temperature_->view(), dt, fluid_.kernel);
             timers_.stop(kHeat);
         }
 
@@ -213,7 +211,7 @@ class BackendSimulation final : public Simulation {
         fill_report(dt, iterations, error, fluid_count, motion);
         report_.retries = retries;
         report_.heat_substeps = has_heat_ ? heat_.last_substeps() : 0;
-        report_.heat_content = has_heat_ ? heat_content_ : 0.0;
+        report_.heat_content = has_heat_ ? heat_.last_content() : 0.0;
         report_.diverged = outcome == PcisphOutcome::kDiverged;
         report_.unconverged = outcome == PcisphOutcome::kOutOfIterations;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
@@ -348,6 +346,12 @@ class BackendSimulation final : public Simulation {
         }
     }
 
+    // V_b of the moving solids' boundary particles (static ones are computed once).
+    void compute_moving_solid_volumes(const GridView& grid) {
+        compute_boundary_volumes(grid, store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
+                                 ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+    }
+
     // Where the heat stage finds each particle's material and volume (heat.hpp).
     HeatMaterials heat_materials() const {
         HeatMaterials m;
@@ -414,7 +418,6 @@ class BackendSimulation final : public Simulation {
     bool has_heat_ = false;                     // heat conduction (heat.hpp)
     DeviceArray<Real>* temperature_ = nullptr;  // its store field
     HeatConduction heat_;
-    double heat_content_ = 0;  // after the last step's heat stage, J
     ParticleCounts counts_;
     long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
     double time_ = 0;
@@ -545,12 +548,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     fluid_.mass = static_cast<Real>(fp.rest_density / sums.sum_W);
     delta_times_dt2_ = pcisph_delta(sums, fp.rest_density, fluid_.mass, 1.0);
     // Brookshaw's Laplacian, rescaled to be exact on the same lattice (heat.hpp).
-    if (has_heat_) {
-        double largest = counts_.by_type[kFluid] > 0 ? double(params_.heat.fluid_diffusivity) : 0.0;
-        for (const SolidSetup& solid : setup.solids)
-            if (solid.kind != SolidKind::kStatic) largest = std::max(largest, double(solid.thermal_diffusivity));
-        heat_.init(moving, params_.heat.max_substeps, heat_lattice_scale(sums), heat_d_per_dt(sums, largest));
-    }
+    if (has_heat_) heat_.init(moving, params_.heat.max_substeps, heat_lattice_scale(sums));
 
     has_fluid_ = counts_.by_type[kFluid] > 0;  // a solids-only scene runs no fluid stage
     use_lists_ = has_fluid_ && (params_.neighbor_lists == SimulationParams::Lists::kAuto
@@ -609,9 +607,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     // The heat's sub-steps from the particles as they start: the solids' g can exceed a fluid
     // lattice's (heat.hpp, calibrate).
     if (has_heat_) {
-        if (solids_.active())
-            compute_boundary_volumes(grid_.view(), store_.position.cview(), boundary_volume_.view(), ranges_.fluid_end,
-                                     ranges_.solid_end - ranges_.fluid_end, true, fluid_.kernel);
+        if (solids_.active()) compute_moving_solid_volumes(grid_.view());
         heat_.calibrate(grid_.view(), ranges_.fluid_end, ranges_.solid_end, store_.position.cview(), heat_materials(),
                         fluid_.kernel);
     }

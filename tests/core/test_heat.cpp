@@ -346,6 +346,23 @@ TEST_CASE("temperatures are part of the saved state: a resumed run ends bitwise 
     CHECK(test::largest_position_difference(after, uninterrupted) == 0);
 }
 
+TEST_CASE("a saved state without temperatures is refused by a scene that conducts heat, in one line") {
+    SimulationSetup cold = hot_box_in_pool(20, 80);
+    cold.params.heat.enabled = false;
+    cold.temperature.clear();
+    StateArchive saved;
+    create_openmp_simulation(cold, 0)->save_state(saved);
+    const std::unique_ptr<Simulation> heated = create_openmp_simulation(hot_box_in_pool(20, 80), 0);
+    std::string message;
+    try {
+        heated->load_state(saved);
+    } catch (const InputError& e) {
+        message = e.what();
+    }
+    CHECK(message.find("no temperatures") != std::string::npos);
+    CHECK(message.find("heat.enabled") != std::string::npos);
+}
+
 TEST_CASE("CUDA and OpenMP conduct heat alike") {
     if (!cuda_backend_info().available) {
         MW_SKIP(cuda_backend_info().description);
