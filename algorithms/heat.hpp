@@ -68,6 +68,9 @@ struct HeatMaterials {
     HeatMaterial fluid;
     Real fluid_mass = 0;
     Real rest_density = 0;  // ρ0: the fluid's V⁰ = m/ρ0
+    // Melting objects' heat absorbed at the melting point, in kelvins of their heat capacity
+    // (melting.hpp): part of the heat content. Empty without a melting object.
+    View<const Real> latent;
 };
 
 // A pass's two sums for particle i: Σ_j c_ij and Σ_j c_ij T_j (c without δt s).
@@ -140,10 +143,14 @@ void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t cou
     });
 }
 
-// The heat content Σ M T of particles [0, count), J (T in °C), in double.
-inline double heat_content(std::size_t count, View<const HeatParticle> particle, View<const Real> temperature) {
+// The heat content Σ M (T + latent) of particles [0, count), J (T in °C), in double; `latent`
+// (melting.hpp) may be empty.
+inline double heat_content(std::size_t count, View<const HeatParticle> particle, View<const Real> temperature,
+                           View<const Real> latent) {
+    const bool has_latent = latent.data() != nullptr;
     return transform_reduce("heat_content", count, 0.0, SumOp{}, [=] MW_HD(std::size_t i) {
-        return double(particle[i].capacity) * double(temperature[i]);
+        const double stored = has_latent ? double(latent[i]) : 0.0;
+        return double(particle[i].capacity) * (double(temperature[i]) + stored);
     });
 }
 
@@ -158,7 +165,7 @@ class HeatConduction {
         particle_.assign(moving, HeatParticle{});
         other_.assign(moving, Real(0));
         solid_rest_volume_.assign(1, Real(0));  // calibrate() sizes it
-        heat_content(moving, particle_.cview(), other_.cview());  // its reduction workspace, before the first step
+        heat_content(moving, particle_.cview(), other_.cview(), View<const Real>{});  // its reduction workspace, before the first step
     }
     // At set-up, with the scene's first volumes and grid: each solid particle's V⁰ (its V_b now),
     // and the largest g / Δt over particles [0, solid_end) (4.33 α / r0² in a fluid at rest for the
@@ -223,7 +230,7 @@ class HeatConduction {
                              a, kernel);
             std::swap(in, out);
         }
-        last_content_ = heat_content(solid_end, particle_.cview(), temperature);
+        last_content_ = heat_content(solid_end, particle_.cview(), temperature, m.latent);
     }
 
     // Each conducting particle's volume, conductivity, heat capacity and γ for this step, and a

@@ -40,7 +40,8 @@ void add_interface_tension(GridView grid, std::size_t fluid_count, View<const Ve
         const Vec3 xi = position[i];
         Vec3 sum{0, 0, 0};
         grid.for_each_solid(xi, [&](std::uint32_t b) {
-            if (t.type[b] != kSurfaceBoundary) return;
+            // A melting object's SBPs (IBP slots, melting.hpp) take no tension yet.
+            if (t.type[b] != kSurfaceBoundary || std::uint32_t(t.solid_slot[b]) < t.ibp_count) return;
             const Vec3 r = xi - position[b];
             const Real r2 = norm2(r);
             const Real w = kernel.W_r2(r2);

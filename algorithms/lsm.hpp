@@ -57,6 +57,7 @@ struct LsmData {
     // Regions
     std::uint32_t region_count = 0;
     const std::uint32_t* region_offsets = nullptr;
+    const std::uint32_t* region_end = nullptr;  // one past each region's last member (lsm_regions.hpp)
     const std::uint32_t* member_index = nullptr;
     const Real* region_mass = nullptr;
     const Vec3* region_c0 = nullptr;
@@ -133,17 +134,18 @@ MW_INLINE bool region_damped(const LsmData& d, std::uint32_t r) {
 inline void lsm_region_update(const LsmData d) {
     // u = x - x0 once per IBP, in slot order: each is read by about (2w + 1)^3 regions.
     parallel_for("lsm_displacements", d.ibp_count, [=] MW_HD(std::size_t s) {
-        d.displacement[s] = d.position[d.store_of_slot[s]] - d.rest[s];
+        const std::uint32_t i = d.store_of_slot[s];
+        if (i != kMeltedSlot) d.displacement[s] = d.position[i] - d.rest[s];
     });
     parallel_for("lsm_region_chunks", d.chunk_count, [=] MW_HD(std::size_t c) {
         const std::uint32_t r = d.chunk_region[c];
-        const std::uint32_t end = c + 1 < d.region_chunks[r + 1] ? d.chunk_begin[c + 1] : d.region_offsets[r + 1];
+        const std::uint32_t end = c + 1 < d.region_chunks[r + 1] ? d.chunk_begin[c + 1] : d.region_end[r];
         d.chunk_sums[c] = sum_region_members(d, d.chunk_begin[c], end, d.region_c0[r],
                                              region_anchor_displacement(d, r), region_damped(d, r), d.forces);
     });
     parallel_for("lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
-        const std::uint32_t begin = d.region_offsets[r], end = d.region_offsets[r + 1];
-        if (begin == end) return;
+        const std::uint32_t begin = d.region_offsets[r], end = d.region_end[r];
+        if (begin == end) return;  // a melted particle's
         const Real M = d.region_mass[r];
         const Vec3 c0 = d.region_c0[r];
         const bool damp = region_damped(d, std::uint32_t(r));
@@ -225,6 +227,7 @@ inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
     parallel_for("lsm_update", d.ibp_count, [=] MW_HD(std::size_t si) {
         const std::uint32_t s = static_cast<std::uint32_t>(si);
         const std::uint32_t i = d.store_of_slot[s];
+        if (i == kMeltedSlot) return;  // now fluid (melting.hpp)
         const LsmObjectParams obj = d.objects[d.object[s]];
         Vec3 x = d.position[i];
         Vec3 v = d.velocity[i];
@@ -276,7 +279,12 @@ inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
 inline void lsm_goals(const LsmData d, View<Vec3> goal) {
     parallel_for("lsm_goals", d.ibp_count, [=] MW_HD(std::size_t si) {
         const std::uint32_t s = static_cast<std::uint32_t>(si);
-        const Vec3 x = d.position[d.store_of_slot[s]];
+        const std::uint32_t i = d.store_of_slot[s];
+        if (i == kMeltedSlot) {
+            goal[s] = Vec3{0, 0, 0};
+            return;
+        }
+        const Vec3 x = d.position[i];
         Mat3 mean_rotation;
         Vec3 rigid_offset, external;
         goal[s] = x + lsm_goal_offset(d, s, x, Vec3{0, 0, 0}, mean_rotation, false, rigid_offset, external);

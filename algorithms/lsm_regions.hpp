@@ -12,11 +12,17 @@
 // jumping across thin gaps (two fingers one lattice cell apart). Membership is symmetric, so the
 // regions containing IBP i are the members of i's own region, and elastic region r has slot r.
 // A rigid object has one region over all its IBPs (region ids after the IBP slots).
+//
+// A melting object (melting.hpp) loses lattice vertices as it melts: its regions are rebuilt over
+// the vertices left (rebuild_elastic_object_regions). Removing a vertex can only shrink a region,
+// so each region keeps the place it was built with and region_end marks how much of it is in use.
 #pragma once
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -64,6 +70,7 @@ struct LsmHostLayout {
     // Regions: members of region r are member_index[region_offsets[r] .. region_offsets[r+1]);
     // member_index continues with the region ids of rigid objects' IBPs.
     std::vector<std::uint32_t> region_offsets;
+    std::vector<std::uint32_t> region_end;  // one past region r's last member (region_offsets[r + 1] as built)
     std::vector<std::uint32_t> member_index;
     std::vector<Real> region_mass;
     std::vector<Vec3> region_c0;
@@ -90,31 +97,52 @@ struct LsmHostLayout {
 
 namespace lsm_detail {
 
-// Members (local IBP indices, increasing) of the region centred on each IBP of one object.
-inline void build_elastic_regions(const std::vector<std::array<int, 3>>& lattice, int w,
-                                  std::vector<std::vector<std::uint32_t>>& members) {
-    const std::size_t n = lattice.size();
-    int lo[3] = {lattice[0][0], lattice[0][1], lattice[0][2]}, hi[3] = {lo[0], lo[1], lo[2]};
-    for (const auto& c : lattice)
-        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
-    const long dims[3] = {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1};
-    if (double(dims[0]) * double(dims[1]) * double(dims[2]) > 4e8)
-        throw InputError("an object's lattice is too large for LSM region building");
-    std::vector<std::int32_t> grid(std::size_t(dims[0] * dims[1] * dims[2]), -1);
-    auto cell = [&](long i, long j, long k) { return std::size_t((k * dims[1] + j) * dims[0] + i); };
-    for (std::size_t p = 0; p < n; ++p) {
-        const long i = lattice[p][0] - lo[0], j = lattice[p][1] - lo[1], k = lattice[p][2] - lo[2];
-        if (grid[cell(i, j, k)] >= 0) throw InputError("two IBPs of one object share a lattice point");
-        grid[cell(i, j, k)] = std::int32_t(p);
+// An object's lattice vertices on a dense grid over their bounding box: at(i, j, k) is the
+// vertex's index in the list, or -1 where there is none (or outside the box).
+struct LatticeGrid {
+    explicit LatticeGrid(const std::vector<std::array<int, 3>>& lattice) {
+        if (lattice.empty()) return;
+        int hi[3] = {lattice[0][0], lattice[0][1], lattice[0][2]};
+        for (int a = 0; a < 3; ++a) lo[a] = lattice[0][a];
+        for (const auto& c : lattice)
+            for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+        for (int a = 0; a < 3; ++a) dims[a] = hi[a] - lo[a] + 1;
+        if (double(dims[0]) * double(dims[1]) * double(dims[2]) > 4e8)
+            throw InputError("an object's lattice is too large for LSM region building");
+        vertex.assign(std::size_t(dims[0] * dims[1] * dims[2]), -1);
+        for (std::size_t p = 0; p < lattice.size(); ++p) {
+            std::int32_t& v = vertex[cell(lattice[p][0] - lo[0], lattice[p][1] - lo[1], lattice[p][2] - lo[2])];
+            if (v >= 0) throw InputError("two IBPs of one object share a lattice point");
+            v = std::int32_t(p);
+        }
     }
-    auto at = [&](long i, long j, long k) -> std::int32_t {
+    // Cell index of grid coordinates (relative to lo), inside the box.
+    std::size_t cell(long i, long j, long k) const { return std::size_t((k * dims[1] + j) * dims[0] + i); }
+    std::int32_t at(long i, long j, long k) const {
         if (i < 0 || j < 0 || k < 0 || i >= dims[0] || j >= dims[1] || k >= dims[2]) return -1;
-        return grid[cell(i, j, k)];
-    };
+        return vertex[cell(i, j, k)];
+    }
+    int lo[3] = {0, 0, 0};
+    long dims[3] = {0, 0, 0};
+    std::vector<std::int32_t> vertex;
+};
+
+// Members (local IBP indices, increasing) of the region centred on each IBP of one object; with
+// `only`, of those whose entry is set (the others are left empty).
+inline void build_elastic_regions(const std::vector<std::array<int, 3>>& lattice, int w,
+                                  std::vector<std::vector<std::uint32_t>>& members,
+                                  const std::vector<std::uint8_t>* only = nullptr) {
+    const std::size_t n = lattice.size();
     members.assign(n, {});
-    std::vector<int> depth(grid.size(), -1);  // BFS marks, reset after each search
+    if (n == 0) return;
+    const LatticeGrid grid(lattice);
+    const int* lo = grid.lo;
+    auto cell = [&](long i, long j, long k) { return grid.cell(i, j, k); };
+    auto at = [&](long i, long j, long k) { return grid.at(i, j, k); };
+    std::vector<int> depth(grid.vertex.size(), -1);  // BFS marks, reset after each search
     std::vector<std::size_t> touched;
     for (std::size_t p = 0; p < n; ++p) {
+        if (only && !(*only)[p]) continue;
         const long ci = lattice[p][0] - lo[0], cj = lattice[p][1] - lo[1], ck = lattice[p][2] - lo[2];
         std::vector<std::uint32_t>& m = members[p];
         bool full = true;
@@ -189,6 +217,51 @@ inline void append_region_chunks(LsmHostLayout& L, std::uint32_t region, std::si
         }
     }
     L.region_chunks[region + 1] = static_cast<std::uint32_t>(L.chunk_begin.size());
+}
+}  // namespace lsm_detail
+
+// A slot whose particle has melted (melting.hpp): store_of_slot holds this, and every per-slot
+// kernel skips it.
+constexpr std::uint32_t kMeltedSlot = 0xffffffffu;
+
+namespace lsm_detail {
+// Region r's rest sums (mass, centre c0, A0 = Σ m̃ q qᵀ, inverse rest inertia) from its members'
+// rest positions and split masses, in double.
+inline void set_region_rest_sums(LsmHostLayout& L, std::size_t r, const std::uint32_t* members_begin,
+                                 const std::uint32_t* members_end) {
+    double M = 0, c[3] = {0, 0, 0};
+    for (const std::uint32_t* it = members_begin; it != members_end; ++it) {
+        const double w = L.ibp_split_mass[*it];
+        const Vec3 x = L.ibp_rest[*it];
+        M += w, c[0] += w * x.x, c[1] += w * x.y, c[2] += w * x.z;
+    }
+    if (M > 0) c[0] /= M, c[1] /= M, c[2] /= M;
+    double a[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy xz yz
+    for (const std::uint32_t* it = members_begin; it != members_end; ++it) {
+        const double w = L.ibp_split_mass[*it];
+        const Vec3 x = L.ibp_rest[*it];
+        const double q[3] = {x.x - c[0], x.y - c[1], x.z - c[2]};
+        a[0] += w * q[0] * q[0], a[1] += w * q[1] * q[1], a[2] += w * q[2] * q[2];
+        a[3] += w * q[0] * q[1], a[4] += w * q[0] * q[2], a[5] += w * q[1] * q[2];
+    }
+    L.region_mass[r] = Real(M);
+    // Nudge c0 (in Real) so that Σ m̃ (x0 - c0), evaluated in Real as the kernels do, is as
+    // close to zero as rounding allows: the goals' momentum balance rests on that sum, and
+    // its rounding error, divided by Δt, would otherwise show up as a slow drift of momentum.
+    Vec3 c0{Real(c[0]), Real(c[1]), Real(c[2])};
+    for (int pass = 0; pass < 3 && M > 0; ++pass) {
+        double e[3] = {0, 0, 0};
+        for (const std::uint32_t* it = members_begin; it != members_end; ++it) {
+            const Vec3 q = L.ibp_rest[*it] - c0;
+            const double w = L.ibp_split_mass[*it];
+            e[0] += w * double(q.x), e[1] += w * double(q.y), e[2] += w * double(q.z);
+        }
+        c0 = c0 + Vec3{Real(e[0] / M), Real(e[1] / M), Real(e[2] / M)};
+    }
+    L.region_c0[r] = c0;
+    L.region_A0[r] = SymMat3{Real(a[0]), Real(a[1]), Real(a[2]), Real(a[3]), Real(a[4]), Real(a[5])};
+    const double tr = a[0] + a[1] + a[2];
+    L.region_inertia_inv[r] = regularised_inverse(tr - a[0], tr - a[1], tr - a[2], -a[3], -a[4], -a[5]);
 }
 }  // namespace lsm_detail
 
@@ -288,6 +361,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
     }
     if (double(L.region_offsets[n_regions]) + double(L.ibp_count) > 4.0e9)
         throw InputError("too many LSM region members (more than 2^32); use a smaller region half-width w");
+    L.region_end.assign(L.region_offsets.begin() + 1, L.region_offsets.end());
     L.member_index.reserve(L.region_offsets[n_regions] + L.ibp_count);
     for (auto& m : region_members) L.member_index.insert(L.member_index.end(), m.begin(), m.end());
     L.region_chunks.assign(n_regions + 1, 0);
@@ -312,41 +386,8 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         }
     }
     // Rest sums per region, in double.
-    for (std::size_t r = 0; r < n_regions; ++r) {
-        double M = 0, c[3] = {0, 0, 0};
-        for (std::uint32_t m : region_members[r]) {
-            const double w = L.ibp_split_mass[m];
-            const Vec3 x = L.ibp_rest[m];
-            M += w, c[0] += w * x.x, c[1] += w * x.y, c[2] += w * x.z;
-        }
-        if (M > 0) c[0] /= M, c[1] /= M, c[2] /= M;
-        double a[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy xz yz
-        for (std::uint32_t m : region_members[r]) {
-            const double w = L.ibp_split_mass[m];
-            const Vec3 x = L.ibp_rest[m];
-            const double q[3] = {x.x - c[0], x.y - c[1], x.z - c[2]};
-            a[0] += w * q[0] * q[0], a[1] += w * q[1] * q[1], a[2] += w * q[2] * q[2];
-            a[3] += w * q[0] * q[1], a[4] += w * q[0] * q[2], a[5] += w * q[1] * q[2];
-        }
-        L.region_mass[r] = Real(M);
-        // Nudge c0 (in Real) so that Σ m̃ (x0 - c0), evaluated in Real as the kernels do, is as
-        // close to zero as rounding allows: the goals' momentum balance rests on that sum, and
-        // its rounding error, divided by Δt, would otherwise show up as a slow drift of momentum.
-        Vec3 c0{Real(c[0]), Real(c[1]), Real(c[2])};
-        for (int pass = 0; pass < 3 && M > 0; ++pass) {
-            double e[3] = {0, 0, 0};
-            for (std::uint32_t m : region_members[r]) {
-                const Vec3 q = L.ibp_rest[m] - c0;
-                const double w = L.ibp_split_mass[m];
-                e[0] += w * double(q.x), e[1] += w * double(q.y), e[2] += w * double(q.z);
-            }
-            c0 = c0 + Vec3{Real(e[0] / M), Real(e[1] / M), Real(e[2] / M)};
-        }
-        L.region_c0[r] = c0;
-        L.region_A0[r] = SymMat3{Real(a[0]), Real(a[1]), Real(a[2]), Real(a[3]), Real(a[4]), Real(a[5])};
-        const double tr = a[0] + a[1] + a[2];
-        L.region_inertia_inv[r] = lsm_detail::regularised_inverse(tr - a[0], tr - a[1], tr - a[2], -a[3], -a[4], -a[5]);
-    }
+    for (std::size_t r = 0; r < n_regions; ++r)
+        lsm_detail::set_region_rest_sums(L, r, region_members[r].data(), region_members[r].data() + region_members[r].size());
     // GPs and SBPs.
     L.gp_offsets.assign(1, 0);
     L.gp_rest.reserve(L.gp_count);
@@ -394,6 +435,94 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         }
     }
     return L;
+}
+
+// Per lattice vertex, how many of its 26 one-ring neighbours are present (among the `alive` ones
+// when given: per vertex, 0 for a gone one). A melting object's vertex with all 26 is an IBP,
+// any other an SBP (METHOD.md, "Particles").
+inline std::vector<std::uint8_t> lattice_one_ring_counts(const std::vector<std::array<int, 3>>& lattice,
+                                                         const std::vector<std::uint8_t>& alive = {}) {
+    std::vector<std::uint8_t> count(lattice.size(), 0);
+    if (lattice.empty()) return count;
+    const lsm_detail::LatticeGrid grid(lattice);
+    for (std::size_t p = 0; p < lattice.size(); ++p) {
+        if (!alive.empty() && !alive[p]) continue;
+        const long ci = lattice[p][0] - grid.lo[0], cj = lattice[p][1] - grid.lo[1], ck = lattice[p][2] - grid.lo[2];
+        int n = 0;
+        for (long dk = -1; dk <= 1; ++dk)
+            for (long dj = -1; dj <= 1; ++dj)
+                for (long di = -1; di <= 1; ++di) {
+                    const std::int32_t q = grid.at(ci + di, cj + dj, ck + dk);
+                    n += (di | dj | dk) != 0 && q >= 0 && (alive.empty() || alive[std::size_t(q)]);
+                }
+        count[p] = std::uint8_t(n);
+    }
+    return count;
+}
+constexpr int kFullOneRing = 26;
+
+// Rebuilds the regions of one elastic object, its IBPs in slots [base, base + lattice.size()),
+// over the vertices still `alive` (per slot, over all of L's IBP slots): the regions, split masses
+// and rest sums it would have been built with had it held only those. Each region stays where it
+// was built, shorter (L.region_end); a gone vertex's region is empty and it is in none.
+// `gone` (local indices), when given, lists the vertices lost since the last rebuild: only the
+// regions they can have touched are redone. A region loses members only through a gone vertex
+// within w links of its centre (any path it lost ran through one), so memberships and split
+// masses change within w lattice steps of a gone vertex, and rest sums, which read the members'
+// split masses, within 2w. Without `gone`, every region is redone (a checkpoint's load).
+inline void rebuild_elastic_object_regions(LsmHostLayout& L, const std::vector<std::array<int, 3>>& lattice, int w,
+                                           std::size_t base, const std::vector<std::uint8_t>& alive,
+                                           const std::vector<std::uint32_t>* gone = nullptr) {
+    const std::size_t n = lattice.size();
+    // Per local vertex: its lattice-step distance to the nearest gone vertex, capped at 2w + 1.
+    const int far = 2 * w + 1;
+    std::vector<int> reach(n, gone ? far : 0);
+    if (gone) {
+        const lsm_detail::LatticeGrid grid(lattice);
+        for (std::uint32_t g : *gone) {
+            const long ci = lattice[g][0] - grid.lo[0], cj = lattice[g][1] - grid.lo[1], ck = lattice[g][2] - grid.lo[2];
+            for (long dk = -2 * w; dk <= 2 * w; ++dk)
+                for (long dj = -2 * w; dj <= 2 * w; ++dj)
+                    for (long di = -2 * w; di <= 2 * w; ++di) {
+                        const std::int32_t q = grid.at(ci + di, cj + dj, ck + dk);
+                        if (q < 0) continue;
+                        const int d = int(std::max({std::labs(di), std::labs(dj), std::labs(dk)}));
+                        reach[std::size_t(q)] = std::min(reach[std::size_t(q)], d);
+                    }
+        }
+    }
+    std::vector<std::array<int, 3>> live;
+    std::vector<std::uint32_t> live_slot;
+    std::vector<std::uint8_t> redo;  // per live vertex: its membership is redone
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t s = base + k;
+        if (!alive[s]) {
+            L.region_end[s] = L.region_offsets[s];
+            L.ibp_regions_end[s] = L.ibp_regions_begin[s];
+            L.region_mass[s] = 0;
+            continue;
+        }
+        live.push_back(lattice[k]);
+        live_slot.push_back(std::uint32_t(s));
+        redo.push_back(reach[k] <= w ? 1 : 0);
+    }
+    std::vector<std::vector<std::uint32_t>> local;
+    lsm_detail::build_elastic_regions(live, w, local, &redo);
+    for (std::size_t q = 0; q < live.size(); ++q) {
+        if (!redo[q]) continue;
+        const std::uint32_t s = live_slot[q];
+        const std::uint32_t begin = L.region_offsets[s];
+        if (local[q].size() > L.region_offsets[s + 1] - begin)
+            throw std::logic_error("LSM region rebuild: a region grew when its object lost particles");
+        for (std::size_t m = 0; m < local[q].size(); ++m) L.member_index[begin + m] = live_slot[local[q][m]];
+        L.region_end[s] = begin + std::uint32_t(local[q].size());
+        L.ibp_regions_end[s] = L.region_end[s];  // membership is symmetric: its regions are its members
+        L.ibp_split_mass[s] = L.ibp_mass[s] / Real(local[q].size());
+    }
+    for (std::uint32_t s : live_slot)
+        if (reach[s - base] <= 2 * w)
+            lsm_detail::set_region_rest_sums(L, s, L.member_index.data() + L.region_offsets[s],
+                                             L.member_index.data() + L.region_end[s]);
 }
 
 }  // namespace mw

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -131,6 +132,13 @@ struct SolidSetup {
     Real interface_tension = 0;   // η of Eq. 9 between its SBPs and the fluid, m⁴ kg⁻¹ s⁻² (interface_tension.hpp)
     Real thermal_diffusivity = Real(1.43e-7);  // α, m²/s, with params.heat (heat.hpp)
     Real heat_capacity = Real(4.18e6);         // ρc, J/(m³ K), with params.heat
+    // Melting (melting.hpp, elastic objects with params.heat only): the object's lattice is all
+    // of it (no GPs, no mesh SBPs; a lattice vertex missing one of its 26 one-ring neighbours has
+    // the SBP type), and an SBP at or above the melting point that has absorbed its latent heat
+    // becomes fluid. Infinite: the object never melts.
+    Real melting_point = std::numeric_limits<Real>::infinity();  // °C
+    Real latent_heat = 0;  // J/kg
+    bool melts() const { return melting_point < std::numeric_limits<Real>::infinity(); }
     // IBPs: index in the setup's lists, integer lattice coordinates, pinned flag (empty = none).
     std::vector<std::uint32_t> ibp;
     std::vector<std::array<int, 3>> lattice;
@@ -187,6 +195,7 @@ struct StepReport {
     double solid_max_speed = 0;       // m/s over the same
     int heat_substeps = 0;  // the heat stage's sub-steps this step (heat.hpp); 0 without it
     double heat_content = 0;  // Σ M T over the conducting particles after the step, J (T in °C; heat.hpp); 0 without it
+    long melted = 0;  // particles melted since the scene started (melting.hpp); 0 without a melting object
     int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged or ran out of iterations
     bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
     bool unconverged = false;  // the last try ran out of iterations above η (or eta_max), without diverging

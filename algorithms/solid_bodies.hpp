@@ -44,6 +44,7 @@ inline SolidSummary summarize_solids(const LsmData d) {
     const MotionSummary m = transform_reduce(
         "solid_summary", d.ibp_count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t s) {
             const std::uint32_t i = d.store_of_slot[s];
+            if (i == kMeltedSlot) return MotionSummary{};  // now fluid (melting.hpp)
             return particle_motion(d.position[i], d.velocity[i], d.mass[s], static_cast<std::uint32_t>(s));
         });
     return SolidSummary{m.kinetic_energy, m.max_speed2, m.first_bad};
@@ -85,6 +86,7 @@ class SolidBodies {
         displacement_.assign(ibp_count_, Vec3{0, 0, 0});
         mean_rotation_.assign(ibp_count_, mat3_identity());
         region_offsets_.upload(L.region_offsets);
+        region_end_.upload(L.region_end);
         member_index_.upload(L.member_index);
         region_mass_.upload(L.region_mass);
         region_c0_.upload(L.region_c0);
@@ -151,7 +153,10 @@ class SolidBodies {
         }
         // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
         // forces act through the regions (lsm.hpp, LsmData::forces).
-        const bool any_fluid = std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end();
+        // A melting object makes fluid of its own (melting.hpp).
+        const bool any_fluid =
+            std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end() ||
+            std::any_of(setup.solids.begin(), setup.solids.end(), [](const SolidSetup& o) { return o.melts(); });
         if (setup.params.two_way_coupling && any_fluid) {
             const SurfaceShares shares = surface_shares(L);
             share_offsets_.upload(shares.offsets);
@@ -168,7 +173,55 @@ class SolidBodies {
                 sbp_impulse_.assign(sbp_count_, Vec3{0, 0, 0});
             }
         }
+        // Melting objects (melting.hpp) rebuild their regions as they lose particles: the host
+        // layout stays for that, and each one's lattice and first slot.
+        for (std::size_t o = 0; o < setup.solids.size(); ++o) {
+            const SolidSetup& solid = setup.solids[o];
+            if (solid.kind != SolidKind::kElastic || !solid.melts()) continue;
+            std::size_t base = 0;
+            while (base < ibp_count_ && std::size_t(L.ibp_object[base]) != o) ++base;
+            melting_.push_back(MeltingLattice{o, base, solid.lattice, solid.region_half_width});
+        }
+        if (!melting_.empty()) host_layout_ = std::move(L);
     }
+
+    // A melting object's lattice: its index in the setup's solids, its first IBP slot, its
+    // lattice coordinates (slot order) and region half-width.
+    struct MeltingLattice {
+        std::size_t object = 0, base = 0;
+        std::vector<std::array<int, 3>> lattice;
+        int region_half_width = 2;
+    };
+    const std::vector<MeltingLattice>& melting_lattices() const { return melting_; }
+
+    // Rebuilds the melting objects' regions over the IBP slots still `alive` (per IBP slot) and
+    // uploads them (lsm_regions.hpp, rebuild_elastic_object_regions): near the vertices `gone`
+    // since the last rebuild (per melting object, local indices), or everywhere without it. Host
+    // work and a copy of the region arrays: only on a step where something melted, and on
+    // loading a checkpoint.
+    void rebuild_melting_regions(const std::vector<std::uint8_t>& alive,
+                                 const std::vector<std::vector<std::uint32_t>>* gone = nullptr) {
+        LsmHostLayout& L = host_layout_;
+        for (std::size_t k = 0; k < melting_.size(); ++k) {
+            const MeltingLattice& m = melting_[k];
+            if (gone && (*gone)[k].empty()) continue;
+            rebuild_elastic_object_regions(L, m.lattice, m.region_half_width, m.base, alive, gone ? &(*gone)[k] : nullptr);
+        }
+        member_index_.upload(L.member_index);
+        region_end_.upload(L.region_end);
+        regions_end_.upload(L.ibp_regions_end);
+        split_mass_.upload(L.ibp_split_mass);
+        region_mass_.upload(L.region_mass);
+        region_c0_.upload(L.region_c0);
+        region_A0_.upload(L.region_A0);
+        region_inertia_inv_.upload(L.region_inertia_inv);
+    }
+    // The slot map (melting.hpp marks melted slots in it) and each IBP and SBP slot's object.
+    View<std::uint32_t> slot_map() { return store_of_slot_.view(); }
+    void slot_map_fill(std::uint32_t value) { store_of_slot_.fill(value); }
+    View<const std::int32_t> slot_objects() const { return object_.cview(); }
+    DeviceArray<std::int32_t>& solid_slot_field() { return *solid_slot_; }
+    std::size_t sbp_count() const { return sbp_count_; }
 
     bool active() const { return ibp_count_ > 0; }
     // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.
@@ -212,6 +265,7 @@ class SolidBodies {
             Vec3 momentum{0, 0, 0};
             Real total = 0;
             for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
+                if (store_of_slot[s] == kMeltedSlot) continue;
                 momentum += mass[s] * velocity[store_of_slot[s]];
                 total += mass[s];
             }
@@ -353,7 +407,7 @@ class SolidBodies {
     std::size_t bytes() const {
         return store_of_slot_.bytes() + rest_.bytes() + mass_.bytes() + split_mass_.bytes() + object_.bytes() +
                pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() + displacement_.bytes() +
-               mean_rotation_.bytes() + region_offsets_.bytes() + member_index_.bytes() + region_mass_.bytes() +
+               mean_rotation_.bytes() + region_offsets_.bytes() + region_end_.bytes() + member_index_.bytes() + region_mass_.bytes() +
                region_c0_.bytes() + region_A0_.bytes() + region_inertia_inv_.bytes() + region_object_.bytes() +
                region_chunks_.bytes() + chunk_begin_.bytes() + chunk_region_.bytes() +
                chunk_sums_.bytes() +
@@ -384,6 +438,7 @@ class SolidBodies {
         d.mean_rotation = mean_rotation_.view().data();
         d.region_count = static_cast<std::uint32_t>(region_mass_.size());
         d.region_offsets = region_offsets_.view().data();
+        d.region_end = region_end_.view().data();
         d.member_index = member_index_.view().data();
         d.region_mass = region_mass_.view().data();
         d.region_c0 = region_c0_.view().data();
@@ -469,7 +524,7 @@ class SolidBodies {
     DeviceArray<Vec3> force_;  // per IBP, the coupling's (empty without it)
     DeviceArray<Vec3> displacement_;  // u = x - x0 per IBP, rewritten every LSM step
     DeviceArray<Mat3> mean_rotation_;
-    DeviceArray<std::uint32_t> region_offsets_, member_index_;
+    DeviceArray<std::uint32_t> region_offsets_, region_end_, member_index_;
     DeviceArray<Real> region_mass_;
     DeviceArray<Vec3> region_c0_;
     DeviceArray<SymMat3> region_A0_, region_inertia_inv_;
@@ -499,6 +554,8 @@ class SolidBodies {
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
     DeviceArray<HeatMaterial> object_heat_;        // per object, its thermal properties (heat conduction only)
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
+    std::vector<MeltingLattice> melting_;   // host: the melting objects' lattices
+    LsmHostLayout host_layout_;             // host: the layout, kept only when an object melts
 };
 
 MW_BACKEND_END

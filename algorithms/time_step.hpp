@@ -13,6 +13,7 @@
 
 #include "algorithms/coupling.hpp"
 #include "algorithms/heat.hpp"
+#include "algorithms/melting.hpp"
 #include "algorithms/interface_tension.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/neighbor_list.hpp"
@@ -203,6 +204,18 @@ class BackendSimulation final : public Simulation {
             timers_.stop(kSolidContact);
         }
 
+        // 8. Melting (melting.hpp): latent heat at the melting point, then the melting objects'
+        //    SBPs that melt become fluid (the next step's sort moves them to the fluid's range),
+        //    the IBPs they leave exposed become SBPs, and the regions are rebuilt.
+        if (has_melting_) {
+            timers_.start(kMelting);
+            const PhaseChangeCounts changed = melting_.step(store_, solids_, *temperature_, fluid_.rest_density);
+            counts_.by_type[kFluid] += changed.melted;
+            counts_.by_type[kSurfaceBoundary] += changed.exposed - changed.melted;
+            counts_.by_type[kInnerBoundary] -= changed.exposed;
+            timers_.stop(kMelting);
+        }
+
         time_ += dt;
         ++step_;
         if (motion.first_bad != 0xffffffffu) report_non_finite(motion.first_bad);
@@ -212,6 +225,7 @@ class BackendSimulation final : public Simulation {
         report_.retries = retries;
         report_.heat_substeps = has_heat_ ? heat_.last_substeps() : 0;
         report_.heat_content = has_heat_ ? heat_.last_content() : 0.0;
+        report_.melted = has_melting_ ? melting_.melted_total() : 0;
         report_.diverged = outcome == PcisphOutcome::kDiverged;
         report_.unconverged = outcome == PcisphOutcome::kOutOfIterations;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
@@ -236,7 +250,7 @@ class BackendSimulation final : public Simulation {
         return store_.bytes() + grid_.bytes() + lists_.bytes() + boundary_volume_.bytes() + nonpressure_.bytes() +
                pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
                contact_boxes_.bytes() + contact_objects_.bytes() + contact_object_distances_.bytes() +
-               impulse_per_weight_.bytes() + fluid_near_solid_.bytes() + heat_.bytes() +
+               impulse_per_weight_.bytes() + fluid_near_solid_.bytes() + heat_.bytes() + melting_.bytes() +
                backend_scratch_bytes();
     }
     double time() const override { return time_; }
@@ -319,11 +333,12 @@ class BackendSimulation final : public Simulation {
         kLsm,
         kIntegrate,
         kSolidContact,
+        kMelting,
         kStageCount
     };
     static constexpr const char* kStageNames[kStageCount] = {
         "neighbors", "solid_volumes", "viscosity", "interface_tension", "pcisph", "heat",
-        "coupling",  "lsm",           "integrate", "solid_contact"};
+        "coupling",  "lsm",           "integrate", "solid_contact",     "melting"};
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
@@ -361,6 +376,7 @@ class BackendSimulation final : public Simulation {
         m.fluid = HeatMaterial{params_.heat.fluid_diffusivity, params_.heat.fluid_capacity};
         m.fluid_mass = fluid_.mass;
         m.rest_density = fluid_.rest_density;
+        m.latent = melting_.latent();
         solids_.describe_heat(m);
         return m;
     }
@@ -418,6 +434,8 @@ class BackendSimulation final : public Simulation {
     bool has_heat_ = false;                     // heat conduction (heat.hpp)
     DeviceArray<Real>* temperature_ = nullptr;  // its store field
     HeatConduction heat_;
+    bool has_melting_ = false;  // an object melts (melting.hpp)
+    PhaseChange melting_;
     ParticleCounts counts_;
     long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
     double time_ = 0;
@@ -503,6 +521,10 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
         temperature_ = &store_.add<Real>("temperature", FieldLife::kPersistent);
         temperature_->upload(temperature);
     }
+    melting_.init(setup, store_, solids_);
+    has_melting_ = melting_.active();
+    // A scene whose objects melt gains fluid: its fluid stages run from the start.
+    const bool holds_fluid = counts_.by_type[kFluid] > 0 || has_melting_;
 
     // The grid covers the domain, its walls and one support radius more; fluid that leaves it is
     // counted as lost.
@@ -521,11 +543,11 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
             throw InputError("simulation setup: the domain walls' correction needs the walls' gap (params.wall_gap)");
         wall_contact_ = WallContact::for_domain(params_.domain_min, params_.domain_max, params_.wall_gap, fp.spacing);
     }
-    if (params_.wall_correction && !params_.static_boxes.empty() && counts_.by_type[kFluid] > 0) {
+    if (params_.wall_correction && !params_.static_boxes.empty() && holds_fluid) {
         contact_boxes_.upload(params_.static_boxes);
         wall_contact_.boxes = contact_boxes_.cview();
     }
-    if (params_.wall_correction && !params_.static_objects.empty() && counts_.by_type[kFluid] > 0) {
+    if (params_.wall_correction && !params_.static_objects.empty() && holds_fluid) {
         std::size_t values = 0;
         for (const ContactField& c : params_.static_objects) {
             if (c.field.nx < 2 || c.field.ny < 2 || c.field.nz < 2 || !(c.field.inv_spacing > 0))
@@ -550,7 +572,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     // Brookshaw's Laplacian, rescaled to be exact on the same lattice (heat.hpp).
     if (has_heat_) heat_.init(moving, params_.heat.max_substeps, heat_lattice_scale(sums));
 
-    has_fluid_ = counts_.by_type[kFluid] > 0;  // a solids-only scene runs no fluid stage
+    has_fluid_ = holds_fluid;  // a solids-only scene runs no fluid stage
     use_lists_ = has_fluid_ && (params_.neighbor_lists == SimulationParams::Lists::kAuto
                                     ? kPrefersNeighborLists
                                     : params_.neighbor_lists == SimulationParams::Lists::kOn);
@@ -597,6 +619,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (solids_.active()) active_stages_.push_back(kLsm);
     if (has_fluid_) active_stages_.push_back(kIntegrate);
     if (has_solid_contact_) active_stages_.push_back(kSolidContact);
+    if (has_melting_) active_stages_.push_back(kMelting);
 
     // One neighbour build now, so that every per-step buffer (sort keys, lists) is allocated
     // before the first step and device_bytes() is the steady-state figure `info` reports.
@@ -697,6 +720,7 @@ void BackendSimulation<Kernel>::load_state(const StateArchive& in) {
     store_.load(in, {"neighbor_count"});
     if (neighbor_count_ && !in.has("store.neighbor_count")) neighbor_count_->fill(0);
     solids_.load(in);
+    melting_.load(store_, solids_);  // the slots left, and their regions, from the loaded slots
     step_size_.load(in);
     time_ = in.get_value<double>("time");
     step_ = in.get_value<long>("step");

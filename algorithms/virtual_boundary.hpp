@@ -102,7 +102,9 @@ struct SolidSurface {
         if (fluid_near_solid && !fluid_near_solid[i]) return k;
         Vec3 normal_sum{0, 0, 0};
         grid.for_each_solid_around_particle(i, [&](std::uint32_t j) {
-            if (type[j] != kSurfaceBoundary) return;
+            // A melting object's SBPs are lattice vertices (IBP slots) with no surface normal:
+            // not in the correction yet (docs/melting.md).
+            if (type[j] != kSurfaceBoundary || std::uint32_t(solid_slot[j]) < ibp_count) return;
             const Vec3 xs = position[j];
             const Real w = contact_weight(x, xs, reach);
             if (!(w > Real(0))) return;

@@ -318,9 +318,11 @@ int command_run(int argc, char** argv) {
             summary.simulated_time = r.time;
             summary.lost_particles = r.lost_particles;
             progress.update(r);
-            if (r.lost_particles > scene.max_lost_fraction * double(summary.particles.by_type[kFluid])) {
+            // Against the fluid there is now: melting objects add to it (the counts are host figures).
+            const long fluid_now = sim->counts().by_type[kFluid];
+            if (r.lost_particles > scene.max_lost_fraction * double(fluid_now)) {
                 progress.finish();
-                throw SimulationError(lost_fluid_message(r, summary.particles.by_type[kFluid], stats, scene));
+                throw SimulationError(lost_fluid_message(r, fluid_now, stats, scene));
             }
             if (r.density_error_max > scene.max_density_error) {
                 progress.finish();
@@ -411,7 +413,7 @@ int command_run(int argc, char** argv) {
     const std::string shown = std::filesystem::absolute(out_dir, ec).lexically_normal().string();
     // The fluid's figures mean nothing in a scene without fluid (all zero): say so instead.
     char fluid_figures[160] = "no fluid";
-    if (summary.particles.by_type[kFluid] > 0)
+    if (summary.particles.by_type[kFluid] > 0 || stats.has_melting())
         std::snprintf(fluid_figures, sizeof fluid_figures, "density error avg %.3g%% max %.3g%%, %.1f iterations/step",
                       100 * stats.density_error_avg(), 100 * stats.density_error_max(), stats.iterations_avg());
     std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",

@@ -143,7 +143,10 @@ void FrameWriter::write_objects(int index, const HostParticles& p) const {
 }
 
 StatsTable::StatsTable(std::vector<std::string> stage_names, bool heat)
-    : stages_(std::move(stage_names)), heat_(heat), stage_ms_(stages_.size()) {}
+    : stages_(std::move(stage_names)),
+      heat_(heat),
+      melting_(std::find(stages_.begin(), stages_.end(), "melting") != stages_.end()),
+      stage_ms_(stages_.size()) {}
 
 void StatsTable::add(const StepReport& r) {
     char buffer[256];
@@ -156,6 +159,11 @@ void StatsTable::add(const StepReport& r) {
         csv_rows_ += buffer;
         if (total_ms_.empty()) heat_first_ = r.heat_content;
         heat_last_ = r.heat_content;
+    }
+    if (melting_) {
+        std::snprintf(buffer, sizeof buffer, ",%ld", r.melted);
+        csv_rows_ += buffer;
+        melted_last_ = r.melted;
     }
     for (std::size_t s = 0; s < stages_.size(); ++s) {
         const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
@@ -179,6 +187,7 @@ std::string StatsTable::header() const {
         "step,time,dt,iterations,density_error_avg,density_error_max,max_speed,kinetic_energy,lost_particles,"
         "dt_retries,diverged,unconverged";
     if (heat_) h += ",heat_content";
+    if (melting_) h += ",melted";
     for (const auto& s : stages_) h += ",ms_" + s;
     return h + ",ms_total";
 }
@@ -281,6 +290,8 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
                              {"at_end", finite_or_null(last)},
                              {"relative_change", finite_or_null(first != 0 ? (last - first) / std::fabs(first) : 0.0)}};
     }
+    // Melting: the particles that have left their objects for the fluid by the end of the run.
+    if (stats.has_melting() && stats.rows() > 0) j["melted_particles"] = stats.melted_last();
     j["device_bytes"] = run.device_bytes;
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;

@@ -30,7 +30,12 @@ class FrameWriter {
    public:
     explicit FrameWriter(const std::string& out_dir);  // creates frames/
     // The solid objects whose meshes go with every frame (static ones: their rest mesh).
-    void set_objects(const std::vector<SolidSetup>& solids) { objects_ = solids; }
+    // A melting object has no mesh to write (its lattice is all of it): its particles show it.
+    void set_objects(const std::vector<SolidSetup>& solids) {
+        objects_.clear();
+        for (const SolidSetup& o : solids)
+            if (!o.melts()) objects_.push_back(o);
+    }
     // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView
     // collection listing every frame with its time. Returns the frame's path.
     std::string write(int index, const HostParticles& particles, double time);
@@ -81,11 +86,16 @@ class StatsTable {
     bool has_heat() const { return heat_; }
     double heat_content_first() const { return heat_first_; }
     double heat_content_last() const { return heat_last_; }
+    // With a melting object (the "melting" stage): a `melted` column, the particles melted so far.
+    bool has_melting() const { return melting_; }
+    long melted_last() const { return melted_last_; }
 
    private:
     std::vector<std::string> stages_;
     bool heat_ = false;
     double heat_first_ = 0, heat_last_ = 0;
+    bool melting_ = false;
+    long melted_last_ = 0;
     std::string earlier_rows_;                   // a resumed run's rows from before its checkpoint
     std::string csv_rows_;                       // every row so far, as written to stats.csv
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]

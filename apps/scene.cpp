@@ -177,6 +177,17 @@ class Section {
         return value;
     }
 
+    // A number that may be absent or null, meaning "none" (resolved as null, so that --set finds
+    // the key).
+    std::optional<double> optional_number(const std::string& key, const Range& range) {
+        const SceneJson* v = find(key);
+        if (!v || v->is_null()) {
+            out_[key] = nullptr;
+            return std::nullopt;
+        }
+        return number(key, std::nullopt, range);
+    }
+
     int integer(const std::string& key, int fallback, int lo, int hi) {
         const SceneJson* v = find(key);
         int value = fallback;
@@ -550,6 +561,17 @@ void read_objects(Section& root, Scene& scene) {
         o.thermal_diffusivity = Real(s.number("thermal_diffusivity", double(scene.params.heat.fluid_diffusivity),
                                               Range::non_negative()));
         o.heat_capacity = Real(s.number("heat_capacity", double(scene.params.heat.fluid_capacity), Range::positive()));
+        // Melting (docs/melting.md): an elastic object in a scene that conducts heat.
+        if (const std::optional<double> melting_point = s.optional_number("melting_point", kTemperatureRange)) {
+            o.melting_point = Real(*melting_point);
+            if (o.kind != SolidKind::kElastic)
+                s.fail(s.key_path("melting_point"), "is for elastic objects (this one is " + kind + ")");
+            if (!scene.params.heat.enabled)
+                s.fail(s.key_path("melting_point"), "needs heat conduction: set heat.enabled to true");
+        }
+        o.latent_heat = Real(s.number("latent_heat", 0.0, Range::non_negative()));
+        if (o.latent_heat > 0 && !o.melts())
+            s.fail(s.key_path("latent_heat"), "needs a melting_point");
         read_object_lsm(s.object("lsm"), o);
         read_object_pinned(s.object("pinned"), o);
         scene.objects.push_back(o);

@@ -4,6 +4,7 @@
 // applied to the raw JSON before validation, so they go through the same checks.
 #pragma once
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,10 @@ struct SceneObject {
     Real temperature = 20;                    // °C, with heat conduction (fluid.temperature by default)
     Real thermal_diffusivity = Real(1.43e-7); // m²/s (fluid.thermal_diffusivity by default)
     Real heat_capacity = Real(4.18e6);        // ρc, J/(m³ K) (fluid.heat_capacity by default)
+    // Melting (docs/melting.md): elastic objects with heat.enabled; infinite: never melts.
+    Real melting_point = std::numeric_limits<Real>::infinity();  // °C
+    Real latent_heat = 0;                                        // J/kg
+    bool melts() const { return melting_point < std::numeric_limits<Real>::infinity(); }
     enum class Pin { kNone, kBox, kHalfSpace } pin = Pin::kNone;
     Vec3 pin_min{}, pin_max{};          // box
     Vec3 pin_point{}, pin_normal{};     // half-space: IBPs with (x - point)·normal < 0 are pinned

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "algorithms/lsm_regions.hpp"
 #include "backend/errors.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/inside_outside.hpp"
@@ -218,6 +219,8 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         solid.interface_tension = o.interface_tension;
         solid.thermal_diffusivity = o.thermal_diffusivity;
         solid.heat_capacity = o.heat_capacity;
+        solid.melting_point = o.melting_point;
+        solid.latent_heat = o.latent_heat;
         std::function<bool(const Vec3&)> pinned;
         if (o.pin == SceneObject::Pin::kBox) {
             const Vec3 lo = o.pin_min, hi = o.pin_max;
@@ -243,7 +246,9 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             started_at(o.temperature);
             // Fluid moving into a static object is stopped by its signed distance (only where the
             // correction is on and there is fluid to stop).
-            if (o.kind == SolidKind::kStatic && scene.params.wall_correction && !scene.fluid_blocks.empty())
+            const bool any_melts = std::any_of(scene.objects.begin(), scene.objects.end(),
+                                               [](const SceneObject& other) { return other.melts(); });
+            if (o.kind == SolidKind::kStatic && scene.params.wall_correction && (!scene.fluid_blocks.empty() || any_melts))
                 add_static_object_distance(setup, object.mesh, scene.params.fluid.spacing, sealed_faces(scene));
             for (std::size_t i = first; check_overlaps && i < first + inner; ++i) {
                 const Vec3 x = setup.position[i];
@@ -359,6 +364,23 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
         for (const auto& p : sample.ibp.positions) push(to_vec3(p), kStaticBoundary);
         for (const auto& p : sample.sbp.positions) push(to_vec3(p), kStaticBoundary);
         for (const auto& v : mesh.vertices) solid.rest_vertices.push_back(to_vec3(v));
+        setup.solids.push_back(std::move(solid));
+        return sample.ibp.count();
+    }
+    if (solid.melts()) {
+        // A melting object is its lattice alone (algorithms/melting.hpp): a vertex missing one of
+        // its 26 one-ring neighbours is an SBP, any other an IBP. Its mesh cannot follow it as it
+        // melts, so no GPs, no mesh SBPs, and no mesh in the frames.
+        const std::vector<std::array<int, 3>> lattice(sample.ibp.lattice.begin(), sample.ibp.lattice.end());
+        const std::vector<std::uint8_t> ring = lattice_one_ring_counts(lattice);
+        for (std::size_t k = 0; k < sample.ibp.count(); ++k) {
+            const Vec3 x = to_vec3(sample.ibp.positions[k]);
+            solid.ibp.push_back(push(x, ring[k] < kFullOneRing ? kSurfaceBoundary : kInnerBoundary));
+            solid.lattice.push_back(lattice[k]);
+            solid.pinned.push_back(pinned && pinned(x) ? 1 : 0);
+        }
+        solid.triangles.clear();
+        solid.gp_offsets.assign(1, 0);
         setup.solids.push_back(std::move(solid));
         return sample.ibp.count();
     }

@@ -1,0 +1,296 @@
+// Melting, the second half (METHOD.md, "Melting"; docs/melting.md): phase change, outside in.
+// Heat conduction (heat.hpp) brings the temperatures; this stage, once a step after the fluid's
+// integration, turns a melting object's surface particles into fluid.
+//
+// A melting object is its lattice (lsm_regions.hpp): every vertex is an LSM particle (an IBP
+// slot), and a vertex missing any of its 26 one-ring neighbours has the SBP type. Each step, for
+// every vertex still in its object:
+// - Latent heat. Its temperature stops at the melting point T_m: heat that would raise it past
+//   T_m is absorbed instead, kept per particle as `latent_heat` in kelvins of the object's own
+//   heat capacity (L ρ / C for a latent heat L per kg), so that Σ M (T + latent) is the heat
+//   content heat.hpp conserves. Below T_m an absorbed store flows back into T first (refreezing).
+// - Phase change. An SBP at T_m whose store has reached L ρ / C melts: it becomes a fluid particle
+//   (type, no slot, no object, the fluid's rest density as its last density) with the velocity
+//   it had, and what it absorbed past the latent heat returns to its temperature (scaled by the
+//   object's heat capacity over the fluid's, so that it stays the same heat per volume). Only
+//   SBPs melt, so an object melts from the outside in.
+// - Its neighbours lose it: a vertex left with fewer than 26 one-ring neighbours becomes an SBP,
+//   and the object's regions are rebuilt over the vertices left (rebuild_elastic_object_regions;
+//   a region only shrinks, in place). The melted particle's slot is marked kMeltedSlot in the slot
+//   map, which every per-slot kernel skips.
+// The step's melt flags are a reduction read back (one synchronisation a step, in scenes with a
+// melting object); the rebuild is host work and a copy of the region arrays, on the steps where
+// something melted only. METHOD.md does the rebuild on the device, by w + 1 rounds of one-ring
+// filling; that is the next step if it shows in the timings (docs/melting.md).
+#pragma once
+#include <cmath>
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "algorithms/lsm_regions.hpp"
+#include "algorithms/particle_store.hpp"
+#include "algorithms/particle_types.hpp"
+#include "algorithms/simulation.hpp"
+#include "algorithms/solid_bodies.hpp"
+#include "backend/backend.hpp"
+#include "backend/reduce_ops.hpp"
+
+MW_BACKEND_BEGIN
+
+// Per object (indexed like SimulationSetup::solids): where it melts and its latent heat.
+struct MeltingPoint {
+    std::uint8_t melts = 0;
+    Real temperature = 0;    // T_m, °C
+    Real latent_kelvin = 0;  // L ρ / C, K
+    Real capacity_ratio = 1; // C / C_fluid: turns a kelvin of the object's heat capacity into the fluid's
+};
+
+// What the latent-heat kernel reads and writes.
+struct MeltingData {
+    const std::uint32_t* store_of_slot = nullptr;
+    const std::int32_t* slot_object = nullptr;
+    const MeltingPoint* objects = nullptr;
+    const std::uint8_t* type = nullptr;  // store fields
+    Real* temperature = nullptr;
+    Real* latent = nullptr;
+    std::uint8_t* melts = nullptr;  // per IBP slot: 1 where it melts this step
+};
+
+// Per IBP slot of a melting object still in it: the latent-heat exchange at T_m, and whether the
+// particle melts now (see the top of the file).
+inline void exchange_latent_heat(std::size_t ibp_count, const MeltingData d) {
+    parallel_for("melting_latent_heat", ibp_count, [=] MW_HD(std::size_t s) {
+        d.melts[s] = 0;
+        const std::uint32_t i = d.store_of_slot[s];
+        if (i == kMeltedSlot) return;
+        const MeltingPoint point = d.objects[d.slot_object[s]];
+        if (!point.melts) return;
+        Real T = d.temperature[i], stored = d.latent[i];
+        if (T > point.temperature) {
+            stored += T - point.temperature;
+            T = point.temperature;
+        } else if (stored > Real(0)) {
+            const Real released = stored < point.temperature - T ? stored : point.temperature - T;
+            stored -= released;
+            T += released;
+        }
+        if (d.type[i] == kSurfaceBoundary && T >= point.temperature && stored >= point.latent_kelvin) {
+            // The heat past the latent heat stays heat as the particle takes the fluid's capacity.
+            T += (stored - point.latent_kelvin) * point.capacity_ratio;
+            stored = 0;
+            d.melts[s] = 1;
+        }
+        d.temperature[i] = T;
+        d.latent[i] = stored;
+    });
+}
+
+// The store's side of a phase change: the `melted` slots' particles become fluid and leave the
+// slot map; the `exposed` slots' particles (still solid) become SBPs.
+struct PhaseChangeData {
+    std::uint32_t* store_of_slot = nullptr;
+    std::uint8_t* type = nullptr;  // store fields
+    std::int32_t* solid_slot = nullptr;
+    std::int32_t* object = nullptr;
+    Real* density = nullptr;
+    Real rest_density = 0;
+};
+inline void apply_phase_change(const PhaseChangeData d, View<const std::uint32_t> melted,
+                               View<const std::uint32_t> exposed) {
+    parallel_for("melting_to_fluid", melted.size(), [=] MW_HD(std::size_t k) {
+        const std::uint32_t s = melted[k];
+        const std::uint32_t i = d.store_of_slot[s];
+        d.type[i] = kFluid;
+        d.solid_slot[i] = -1;
+        d.object[i] = -1;
+        d.density[i] = d.rest_density;
+        d.store_of_slot[s] = kMeltedSlot;
+    });
+    parallel_for("melting_exposed", exposed.size(), [=] MW_HD(std::size_t k) {
+        d.type[d.store_of_slot[exposed[k]]] = kSurfaceBoundary;
+    });
+}
+
+// What one step's phase change did.
+struct PhaseChangeCounts {
+    long melted = 0;   // SBPs that became fluid
+    long exposed = 0;  // IBPs that became SBPs
+};
+
+// The stage: its buffers, and the host's record of which lattice vertices are left.
+class PhaseChange {
+   public:
+    // `solids` initialised. Registers the store field `latent_heat` (K, 0 to start). Throws
+    // InputError for a melting object that is not elastic, or melting without heat conduction.
+    void init(const SimulationSetup& setup, ParticleStore& store, SolidBodies& solids) {
+        std::vector<MeltingPoint> points(setup.solids.size());
+        bool any = false;
+        for (std::size_t o = 0; o < setup.solids.size(); ++o) {
+            const SolidSetup& solid = setup.solids[o];
+            if (!solid.melts()) continue;
+            if (solid.kind != SolidKind::kElastic)
+                throw InputError("simulation setup: solid \"" + solid.name + "\" melts; only elastic objects can");
+            if (!setup.params.heat.enabled)
+                throw InputError("simulation setup: solid \"" + solid.name + "\" melts; melting needs heat conduction");
+            if (!std::isfinite(double(solid.melting_point)) || !(solid.latent_heat >= 0) ||
+                !std::isfinite(double(solid.latent_heat)))
+                throw InputError("simulation setup: solid \"" + solid.name +
+                                 "\" needs a finite melting point and a finite latent heat >= 0");
+            if (!solid.gp.empty() || !solid.sbp.empty())
+                throw InputError("simulation setup: solid \"" + solid.name +
+                                 "\" melts, so it must be its lattice alone (no mesh vertices or surface samples)");
+            points[o].melts = 1;
+            points[o].temperature = solid.melting_point;
+            points[o].latent_kelvin = static_cast<Real>(double(solid.latent_heat) * double(solid.density) /
+                                                        double(solid.heat_capacity));
+            points[o].capacity_ratio =
+                static_cast<Real>(double(solid.heat_capacity) / double(setup.params.heat.fluid_capacity));
+            any = true;
+        }
+        if (!any) return;
+        ibp_count_ = solids.ibp_count();
+        points_.upload(points);
+        latent_ = &store.add<Real>("latent_heat", FieldLife::kPersistent);
+        latent_->fill(Real(0));
+        melts_.assign(std::max<std::size_t>(1, ibp_count_), 0);
+        // Sized for the most one step can melt, so that a step allocates nothing.
+        melted_.resize(ibp_count_);
+        exposed_.resize(ibp_count_);
+        alive_.assign(ibp_count_, 1);
+        ring_.assign(ibp_count_, 0);
+        // The melting objects' particles must carry the SBP type exactly where a one-ring
+        // neighbour is missing: that is what decides which may melt.
+        const std::vector<std::uint8_t>& type_of_scene = setup.type;
+        for (const auto& m : solids.melting_lattices()) {
+            grids_.emplace_back(m.lattice);
+            const std::vector<std::uint8_t> ring = lattice_one_ring_counts(m.lattice);
+            std::copy(ring.begin(), ring.end(), ring_.begin() + long(m.base));
+            const SolidSetup& solid = setup.solids[m.object];
+            for (std::size_t k = 0; k < m.lattice.size(); ++k) {
+                const std::uint8_t expected = ring[k] < kFullOneRing ? kSurfaceBoundary : kInnerBoundary;
+                if (type_of_scene[solid.ibp[k]] != expected)
+                    throw InputError("simulation setup: solid \"" + solid.name +
+                                     "\" melts; a lattice vertex with " + std::to_string(int(ring[k])) +
+                                     " of its 26 one-ring neighbours must have the " + particle_type_name(expected) +
+                                     " type");
+            }
+        }
+        // The reduction's workspace, before the first step.
+        count_melting();
+    }
+
+    bool active() const { return latent_ != nullptr; }
+    View<const Real> latent() const { return latent_ ? latent_->cview() : View<const Real>{}; }
+    // Particles melted since the scene started.
+    long melted_total() const {
+        long gone = 0;
+        for (std::uint8_t a : alive_) gone += a == 0;
+        return gone;
+    }
+
+    // One step (the slot map current, this step's temperatures in `temperature`).
+    PhaseChangeCounts step(ParticleStore& store, SolidBodies& solids, DeviceArray<Real>& temperature,
+                           Real rest_density) {
+        MeltingData d;
+        d.store_of_slot = solids.slot_map().data();
+        d.slot_object = solids.slot_objects().data();
+        d.objects = points_.view().data();
+        d.type = store.type.cview().data();
+        d.temperature = temperature.view().data();
+        d.latent = latent_->view().data();
+        d.melts = melts_.view().data();
+        exchange_latent_heat(ibp_count_, d);
+        PhaseChangeCounts counts;
+        if (count_melting() == 0) return counts;
+        // Something melts: which (a copy to the host), who is exposed, the regions left.
+        const std::vector<std::uint8_t> melts = melts_.to_host();
+        const auto& lattices = solids.melting_lattices();
+        std::vector<std::uint32_t> melted, exposed;
+        std::vector<std::vector<std::uint32_t>> gone(lattices.size());
+        for (std::size_t o = 0; o < lattices.size(); ++o)
+            for (std::size_t k = 0; k < lattices[o].lattice.size(); ++k) {
+                const std::size_t s = lattices[o].base + k;
+                if (!melts[s]) continue;
+                melted.push_back(std::uint32_t(s));
+                gone[o].push_back(std::uint32_t(k));
+                alive_[s] = 0;
+            }
+        // A vertex whose last full one-ring lost a member is exposed: it becomes an SBP.
+        for (std::size_t o = 0; o < lattices.size(); ++o) {
+            const auto& m = lattices[o];
+            const lsm_detail::LatticeGrid& grid = grids_[o];
+            for (std::uint32_t g : gone[o]) {
+                const long ci = m.lattice[g][0] - grid.lo[0], cj = m.lattice[g][1] - grid.lo[1],
+                           ck = m.lattice[g][2] - grid.lo[2];
+                for (long dk = -1; dk <= 1; ++dk)
+                    for (long dj = -1; dj <= 1; ++dj)
+                        for (long di = -1; di <= 1; ++di) {
+                            const std::int32_t q = grid.at(ci + di, cj + dj, ck + dk);
+                            if ((di | dj | dk) == 0 || q < 0) continue;
+                            const std::size_t s = m.base + std::size_t(q);
+                            if (ring_[s]-- == kFullOneRing && alive_[s]) exposed.push_back(std::uint32_t(s));
+                        }
+            }
+        }
+        melted_.upload_range(melted.data(), 0, melted.size());
+        exposed_.upload_range(exposed.data(), 0, exposed.size());
+        PhaseChangeData p;
+        p.store_of_slot = solids.slot_map().data();
+        p.type = store.type.view().data();
+        p.solid_slot = solids.solid_slot_field().view().data();
+        p.object = store.object.view().data();
+        p.density = store.density.view().data();
+        p.rest_density = rest_density;
+        apply_phase_change(p, View<const std::uint32_t>{melted_.cview().data(), melted.size()},
+                           View<const std::uint32_t>{exposed_.cview().data(), exposed.size()});
+        solids.rebuild_melting_regions(alive_, &gone);
+        counts.melted = long(melted.size());
+        counts.exposed = long(exposed.size());
+        return counts;
+    }
+
+    // After a checkpoint's store has loaded: the slots left are those some particle still holds;
+    // the regions are rebuilt over them and the others marked melted in the slot map (which the
+    // next step's sort fills for the rest).
+    void load(const ParticleStore& store, SolidBodies& solids) {
+        if (!active()) return;
+        const std::vector<std::int32_t> slot = solids.solid_slot_field().to_host();
+        std::vector<std::uint8_t> held(ibp_count_, 0);
+        for (std::size_t i = 0; i < store.moving_count(); ++i)
+            if (slot[i] >= 0 && std::size_t(slot[i]) < ibp_count_) held[std::size_t(slot[i])] = 1;
+        alive_.assign(ibp_count_, 1);
+        for (const auto& m : solids.melting_lattices()) {
+            for (std::size_t k = 0; k < m.lattice.size(); ++k) alive_[m.base + k] = held[m.base + k];
+            const std::vector<std::uint8_t> ring = lattice_one_ring_counts(
+                m.lattice, std::vector<std::uint8_t>(held.begin() + long(m.base), held.begin() + long(m.base + m.lattice.size())));
+            std::copy(ring.begin(), ring.end(), ring_.begin() + long(m.base));
+        }
+        solids.rebuild_melting_regions(alive_);
+        solids.slot_map_fill(kMeltedSlot);
+        solids.update_slot_map(store);
+    }
+
+    std::size_t bytes() const { return points_.bytes() + melts_.bytes() + melted_.bytes() + exposed_.bytes(); }
+
+    // The number of slots flagged to melt this step (a reduction read back). Public only because
+    // nvcc allows no device lambda in a private member function.
+    long count_melting() {
+        const std::uint8_t* melts = melts_.cview().data();
+        return long(transform_reduce("melting_count", ibp_count_, std::uint32_t(0), SumOp{},
+                                     [=] MW_HD(std::size_t s) { return std::uint32_t(melts[s]); }));
+    }
+
+   private:
+    std::size_t ibp_count_ = 0;
+    DeviceArray<MeltingPoint> points_;         // per object
+    DeviceArray<Real>* latent_ = nullptr;      // store field: heat absorbed at T_m, K
+    DeviceArray<std::uint8_t> melts_;          // per IBP slot, this step's
+    DeviceArray<std::uint32_t> melted_, exposed_;  // this step's lists (capacity: every IBP slot)
+    std::vector<std::uint8_t> alive_;          // host, per IBP slot: still in its object
+    std::vector<std::uint8_t> ring_;           // host, per IBP slot: one-ring neighbours still in it
+    std::vector<lsm_detail::LatticeGrid> grids_;  // host, per melting object: its lattice's grid
+};
+
+MW_BACKEND_END
