@@ -18,10 +18,10 @@
 // so each region keeps the place it was built with and region_end marks how much of it is in use.
 #pragma once
 #include <algorithm>
-#include <cstdlib>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -95,12 +95,10 @@ struct LsmHostLayout {
     std::size_t slot_count() const { return ibp_count + sbp_count + gp_count; }
 };
 
-namespace lsm_detail {
-
 // An object's lattice vertices on a dense grid over their bounding box: at(i, j, k) is the
 // vertex's index in the list, or -1 where there is none (or outside the box).
-struct LatticeGrid {
-    explicit LatticeGrid(const std::vector<std::array<int, 3>>& lattice) {
+struct LatticeIndex {
+    explicit LatticeIndex(const std::vector<std::array<int, 3>>& lattice) {
         if (lattice.empty()) return;
         int hi[3] = {lattice[0][0], lattice[0][1], lattice[0][2]};
         for (int a = 0; a < 3; ++a) lo[a] = lattice[0][a];
@@ -127,6 +125,8 @@ struct LatticeGrid {
     std::vector<std::int32_t> vertex;
 };
 
+namespace lsm_detail {
+
 // Members (local IBP indices, increasing) of the region centred on each IBP of one object; with
 // `only`, of those whose entry is set (the others are left empty).
 inline void build_elastic_regions(const std::vector<std::array<int, 3>>& lattice, int w,
@@ -135,7 +135,7 @@ inline void build_elastic_regions(const std::vector<std::array<int, 3>>& lattice
     const std::size_t n = lattice.size();
     members.assign(n, {});
     if (n == 0) return;
-    const LatticeGrid grid(lattice);
+    const LatticeIndex grid(lattice);
     const int* lo = grid.lo;
     auto cell = [&](long i, long j, long k) { return grid.cell(i, j, k); };
     auto at = [&](long i, long j, long k) { return grid.at(i, j, k); };
@@ -444,7 +444,7 @@ inline std::vector<std::uint8_t> lattice_one_ring_counts(const std::vector<std::
                                                          const std::vector<std::uint8_t>& alive = {}) {
     std::vector<std::uint8_t> count(lattice.size(), 0);
     if (lattice.empty()) return count;
-    const lsm_detail::LatticeGrid grid(lattice);
+    const LatticeIndex grid(lattice);
     for (std::size_t p = 0; p < lattice.size(); ++p) {
         if (!alive.empty() && !alive[p]) continue;
         const long ci = lattice[p][0] - grid.lo[0], cj = lattice[p][1] - grid.lo[1], ck = lattice[p][2] - grid.lo[2];
@@ -478,7 +478,7 @@ inline void rebuild_elastic_object_regions(LsmHostLayout& L, const std::vector<s
     const int far = 2 * w + 1;
     std::vector<int> reach(n, gone ? far : 0);
     if (gone) {
-        const lsm_detail::LatticeGrid grid(lattice);
+        const LatticeIndex grid(lattice);
         for (std::uint32_t g : *gone) {
             const long ci = lattice[g][0] - grid.lo[0], cj = lattice[g][1] - grid.lo[1], ck = lattice[g][2] - grid.lo[2];
             for (long dk = -2 * w; dk <= 2 * w; ++dk)

@@ -23,8 +23,8 @@
 // something melted only. METHOD.md does the rebuild on the device, by w + 1 rounds of one-ring
 // filling; that is the next step if it shows in the timings (docs/melting.md).
 #pragma once
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -184,11 +184,7 @@ class PhaseChange {
     bool active() const { return latent_ != nullptr; }
     View<const Real> latent() const { return latent_ ? latent_->cview() : View<const Real>{}; }
     // Particles melted since the scene started.
-    long melted_total() const {
-        long gone = 0;
-        for (std::uint8_t a : alive_) gone += a == 0;
-        return gone;
-    }
+    long melted_total() const { return melted_total_; }
 
     // One step (the slot map current, this step's temperatures in `temperature`).
     PhaseChangeCounts step(ParticleStore& store, SolidBodies& solids, DeviceArray<Real>& temperature,
@@ -205,7 +201,8 @@ class PhaseChange {
         PhaseChangeCounts counts;
         if (count_melting() == 0) return counts;
         // Something melts: which (a copy to the host), who is exposed, the regions left.
-        const std::vector<std::uint8_t> melts = melts_.to_host();
+        melts_.download(melts_host_);
+        const std::vector<std::uint8_t>& melts = melts_host_;
         const auto& lattices = solids.melting_lattices();
         std::vector<std::uint32_t> melted, exposed;
         std::vector<std::vector<std::uint32_t>> gone(lattices.size());
@@ -220,7 +217,7 @@ class PhaseChange {
         // A vertex whose last full one-ring lost a member is exposed: it becomes an SBP.
         for (std::size_t o = 0; o < lattices.size(); ++o) {
             const auto& m = lattices[o];
-            const lsm_detail::LatticeGrid& grid = grids_[o];
+            const LatticeIndex& grid = grids_[o];
             for (std::uint32_t g : gone[o]) {
                 const long ci = m.lattice[g][0] - grid.lo[0], cj = m.lattice[g][1] - grid.lo[1],
                            ck = m.lattice[g][2] - grid.lo[2];
@@ -247,6 +244,7 @@ class PhaseChange {
                            View<const std::uint32_t>{exposed_.cview().data(), exposed.size()});
         solids.rebuild_melting_regions(alive_, &gone);
         counts.melted = long(melted.size());
+        melted_total_ += counts.melted;
         counts.exposed = long(exposed.size());
         return counts;
     }
@@ -267,6 +265,7 @@ class PhaseChange {
                 m.lattice, std::vector<std::uint8_t>(held.begin() + long(m.base), held.begin() + long(m.base + m.lattice.size())));
             std::copy(ring.begin(), ring.end(), ring_.begin() + long(m.base));
         }
+        melted_total_ = long(std::count(alive_.begin(), alive_.end(), std::uint8_t(0)));
         solids.rebuild_melting_regions(alive_);
         solids.slot_map_fill(kMeltedSlot);
         solids.update_slot_map(store);
@@ -289,8 +288,10 @@ class PhaseChange {
     DeviceArray<std::uint8_t> melts_;          // per IBP slot, this step's
     DeviceArray<std::uint32_t> melted_, exposed_;  // this step's lists (capacity: every IBP slot)
     std::vector<std::uint8_t> alive_;          // host, per IBP slot: still in its object
+    std::vector<std::uint8_t> melts_host_;     // host copy of melts_, on steps where something melts
+    long melted_total_ = 0;
     std::vector<std::uint8_t> ring_;           // host, per IBP slot: one-ring neighbours still in it
-    std::vector<lsm_detail::LatticeGrid> grids_;  // host, per melting object: its lattice's grid
+    std::vector<LatticeIndex> grids_;  // host, per melting object: its lattice's grid
 };
 
 MW_BACKEND_END

@@ -178,9 +178,7 @@ class SolidBodies {
         for (std::size_t o = 0; o < setup.solids.size(); ++o) {
             const SolidSetup& solid = setup.solids[o];
             if (solid.kind != SolidKind::kElastic || !solid.melts()) continue;
-            std::size_t base = 0;
-            while (base < ibp_count_ && std::size_t(L.ibp_object[base]) != o) ++base;
-            melting_.push_back(MeltingLattice{o, base, solid.lattice, solid.region_half_width});
+            melting_.push_back(MeltingLattice{o, ibp_begin[o], solid.lattice, solid.region_half_width});
         }
         if (!melting_.empty()) host_layout_ = std::move(L);
     }
@@ -221,7 +219,6 @@ class SolidBodies {
     void slot_map_fill(std::uint32_t value) { store_of_slot_.fill(value); }
     View<const std::int32_t> slot_objects() const { return object_.cview(); }
     DeviceArray<std::int32_t>& solid_slot_field() { return *solid_slot_; }
-    std::size_t sbp_count() const { return sbp_count_; }
 
     bool active() const { return ibp_count_ > 0; }
     // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.

@@ -289,14 +289,7 @@ TEST_CASE("two solids conduct heat to each other without any fluid") {
     // Two rigid boxes one r0 apart, no fluid, no gravity: the surface particles facing each other
     // conduct; the boxes' inner particles carry the heat in and out.
     const Vec3 lo{0, 0, 0}, hi{0.4f, 0.3f, 0.3f};
-    // The walled domain of fluid_in_box with its one-particle block taken out again (it comes first).
-    SimulationSetup setup = test::fluid_in_box(lo, hi, lo, Vec3{kR0, kR0, kR0}, kR0, Real(0.002));
-    REQUIRE(setup.type[0] == kFluid);
-    REQUIRE(setup.type[1] != kFluid);
-    setup.position.erase(setup.position.begin());
-    setup.velocity.erase(setup.velocity.begin());
-    setup.type.erase(setup.type.begin());
-    setup.object.erase(setup.object.begin());
+    SimulationSetup setup = test::empty_domain(lo, hi, kR0, Real(0.002));
     setup.params.gravity = Vec3{0, 0, 0};
     setup.params.heat.enabled = true;
     SolidSetup solid;

@@ -17,18 +17,6 @@ namespace {
 
 constexpr Real kR0 = 0.02;
 
-// A walled, empty domain (fluid_in_box's walls; its one-particle fluid block taken out again).
-SimulationSetup empty_domain(Vec3 lo, Vec3 hi, Real dt) {
-    SimulationSetup setup = test::fluid_in_box(lo, hi, lo, Vec3{kR0, kR0, kR0}, kR0, dt);
-    REQUIRE(setup.type[0] == kFluid);
-    REQUIRE(setup.type[1] != kFluid);
-    setup.position.erase(setup.position.begin());
-    setup.velocity.erase(setup.velocity.begin());
-    setup.type.erase(setup.type.begin());
-    setup.object.erase(setup.object.begin());
-    return setup;
-}
-
 SolidSetup melting_solid(double melting_point, double latent_heat) {
     SolidSetup solid;
     solid.name = "ice";
@@ -71,7 +59,7 @@ SimulationSetup lattice_cube(int n, const std::vector<std::uint8_t>& keep = {}) 
 }  // namespace
 
 TEST_CASE("a melting object is its lattice: a vertex missing a one-ring neighbour is an SBP") {
-    SimulationSetup setup = empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, Real(0.002));
+    SimulationSetup setup = test::empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, kR0, Real(0.002));
     setup.params.heat.enabled = true;
     test::add_box_solid(setup, Vec3d(0.13, 0.13, 0.13), Vec3d(0.15, 0.15, 0.15), melting_solid(0, 0), Vec3{0, 0, 0});
     const SolidSetup& solid = setup.solids.at(0);
@@ -153,7 +141,7 @@ TEST_CASE("regions rebuilt over the vertices left are those of an object built f
 TEST_CASE("an object above its melting point melts from the outside in, one lattice layer a step, to the last particle") {
     // No gravity, latent heat 0, every particle 30 K above the melting point: each step the SBPs
     // melt and the IBPs they leave exposed become the next SBPs.
-    SimulationSetup setup = empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, Real(0.002));
+    SimulationSetup setup = test::empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, kR0, Real(0.002));
     setup.params.gravity = Vec3{0, 0, 0};
     setup.params.heat.enabled = true;
     test::add_box_solid(setup, Vec3d(0.13, 0.13, 0.13), Vec3d(0.15, 0.15, 0.15), melting_solid(0, 0), Vec3{0, 0, 0});
@@ -303,7 +291,7 @@ TEST_CASE("a checkpoint taken mid-melt resumes bitwise where the whole run ends"
 }
 
 TEST_CASE("only elastic objects melt, and only with heat conduction") {
-    SimulationSetup setup = empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, Real(0.002));
+    SimulationSetup setup = test::empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, kR0, Real(0.002));
     SolidSetup solid = melting_solid(0, 0);
     solid.kind = SolidKind::kRigid;
     test::add_box_solid(setup, Vec3d(0.1, 0.1, 0.1), Vec3d(0.15, 0.15, 0.15), solid, Vec3{0, 0, 0});
@@ -320,7 +308,7 @@ TEST_CASE("CUDA: an object melts layer by layer as on OpenMP") {
         MW_SKIP("no CUDA device: the cross-backend melting test needs one");
         return;
     }
-    SimulationSetup setup = empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, Real(0.002));
+    SimulationSetup setup = test::empty_domain(Vec3{0, 0, 0}, Vec3{0.3f, 0.3f, 0.3f}, kR0, Real(0.002));
     setup.params.heat.enabled = true;
     test::add_box_solid(setup, Vec3d(0.13, 0.13, 0.13), Vec3d(0.15, 0.15, 0.15), melting_solid(0, 0), Vec3{0, 0, 0});
     for (std::size_t i = 0; i < setup.position.size(); ++i) setup.temperature.push_back(Real(setup.object[i] < 0 ? 0 : 30));

@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,19 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
     }
     setup.velocity.assign(setup.position.size(), Vec3{0, 0, 0});
     setup.object.assign(setup.position.size(), -1);
+    return setup;
+}
+
+// A walled domain [lo, hi] with no fluid: fluid_in_box's walls, its one-particle block (which
+// comes first) taken out again. For scenes of solids alone.
+inline SimulationSetup empty_domain(Vec3 lo, Vec3 hi, Real r0, Real dt) {
+    SimulationSetup setup = fluid_in_box(lo, hi, lo, Vec3{r0, r0, r0}, r0, dt);
+    if (setup.type.empty() || setup.type[0] != kFluid || (setup.type.size() > 1 && setup.type[1] == kFluid))
+        throw std::logic_error("empty_domain: fluid_in_box no longer starts with a one-particle block");
+    setup.position.erase(setup.position.begin());
+    setup.velocity.erase(setup.velocity.begin());
+    setup.type.erase(setup.type.begin());
+    setup.object.erase(setup.object.begin());
     return setup;
 }
 
