@@ -143,7 +143,8 @@ struct SolidSetup {
     std::vector<std::uint32_t> ibp;
     std::vector<std::array<int, 3>> lattice;
     std::vector<std::uint8_t> pinned;
-    // GPs (mesh vertices, in mesh order): index in the setup's lists; CSR links to IBPs (indices
+    // GPs (the vertices of the sampler's mesh: the mesh's own, in order, then the midpoints its
+    // refinement added, sampling/mesh_refinement.hpp): index in the setup's lists; CSR links to IBPs (indices
     // into `ibp`) with kernel weights W(x0_g - x0_d) (Eq. 19 normalises them).
     std::vector<std::uint32_t> gp;
     std::vector<int> gp_offsets, gp_links;

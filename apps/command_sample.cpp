@@ -198,7 +198,9 @@ int command_sample(int argc, char** argv) {
     std::printf("mesh        %s: %zu triangles, %s (%zu boundary edges)%s\n", mesh.source.c_str(), st.triangles,
                 st.closed ? "closed" : "open", st.boundary_edges, st.flipped ? ", re-oriented outward" : "");
     std::printf("spacing     r0 = %g, h = %g\n", r0, h);
-    std::printf("counts      SBP %zu, IBP %zu, GP %zu\n", st.sbp_count, st.ibp_count, st.gp_count);
+    std::printf("counts      SBP %zu, IBP %zu, GP %zu (the vertices of the mesh refined to %zu triangles, no edge "
+                "longer than r0, as an elastic or rigid object's GPs are)\n",
+                st.sbp_count, st.ibp_count, st.gp_count, st.geometry_triangles);
     if (opt.measure_coverage)
         std::printf("coverage    largest surface gap %.4g (%.3f r0), mean %.3f r0, %zu random surface probes\n",
                     st.largest_gap, st.largest_gap / r0, st.mean_gap / r0, st.coverage_probes);

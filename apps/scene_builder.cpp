@@ -343,6 +343,8 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
                              const std::function<bool(const Vec3&)>& pinned) {
     SampleOptions options;
     options.measure_coverage = false;
+    // Only an elastic or rigid object's SBPs follow GPs: no refinement for the others.
+    if (solid.kind == SolidKind::kStatic || solid.melts()) options.geometry_max_edge = 0;
     const SolidSample sample = sample_solid(mesh, r0, h, options);
     if (sample.ibp.count() == 0)
         throw InputError("the mesh holds no inner particle at spacing " + std::to_string(r0) +
@@ -356,10 +358,8 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
         return static_cast<std::uint32_t>(setup.position.size() - 1);
     };
     solid.spacing = Real(r0);
-    // The sampler orients the mesh outward (flipping it when its volume is negative): do the same
-    // to the triangles kept for output.
-    for (const auto& t : mesh.triangles)
-        solid.triangles.push_back(sample.stats.flipped ? std::array<int, 3>{t[0], t[2], t[1]} : t);
+    // The sampler's mesh: oriented outward and, for a moving object, refined (its GPs' mesh).
+    solid.triangles = sample.geometry.triangles;
     if (solid.kind == SolidKind::kStatic) {
         for (const auto& p : sample.ibp.positions) push(to_vec3(p), kStaticBoundary);
         for (const auto& p : sample.sbp.positions) push(to_vec3(p), kStaticBoundary);

@@ -79,13 +79,21 @@ SolidSample sample_solid(const TriangleMesh& input, double spacing, double suppo
     out.timings.surface = since(t0);
 
     t0 = Clock::now();
-    out.gp = link_geometry(mesh, out.ibp.positions, support_radius);
+    if (options.geometry_max_edge > 0) {
+        const RefinedMesh refined = refine_long_edges(mesh, options.geometry_max_edge * spacing);
+        for (std::size_t k = 0; k < out.sbp.count(); ++k) refined.locate(out.sbp.triangles[k], out.sbp.barycentric[k]);
+        out.geometry = refined.mesh;
+    } else {
+        out.geometry = mesh;
+    }
+    out.gp = link_geometry(out.geometry, out.ibp.positions, support_radius);
     out.timings.geometry = since(t0);
     out.timings.total = since(t_all);
 
     st.ibp_count = out.ibp.count();
     st.sbp_count = out.sbp.count();
     st.gp_count = out.gp.count();
+    st.geometry_triangles = out.geometry.triangles.size();
     st.ibp_volume = double(st.ibp_count) * spacing * spacing * spacing;
     st.ambiguous_points = out.ibp.classification.ambiguous;
     st.refined_points = out.ibp.classification.refined;

@@ -8,6 +8,7 @@
 #include "sampling/inside_outside.hpp"
 #include "sampling/lattice_sampler.hpp"
 #include "sampling/mesh.hpp"
+#include "sampling/mesh_refinement.hpp"
 #include "sampling/surface_sampler.hpp"
 
 namespace mw {
@@ -20,6 +21,10 @@ struct SampleOptions {
     double coverage_probes_per_r0sq = 16;
     std::size_t coverage_min_probes = 20000;
     std::size_t coverage_max_probes = 2000000;
+    // Edges longer than this (× r0) are split for the GPs, and the SBPs' triangles and weights
+    // moved onto the refined mesh (mesh_refinement.hpp: a coarse mesh would hand a face's whole
+    // fluid force to the IBPs at its corners). 0 keeps the mesh's own vertices as the GPs.
+    double geometry_max_edge = 1.0;
 };
 
 struct SampleTimings {  // seconds, wall clock
@@ -28,7 +33,7 @@ struct SampleTimings {  // seconds, wall clock
     double refine = 0;    // winding-number refinement near holes (part of inner)
     double inner = 0;     // inside/outside ray casts + IBP lattice + one-ring connectivity
     double surface = 0;   // SBPs
-    double geometry = 0;  // GP links
+    double geometry = 0;  // mesh refinement and GP links
     double coverage = 0;  // the coverage check (statistics, not needed for a run)
     double total = 0;     // everything but the coverage check
 };
@@ -36,6 +41,7 @@ struct SampleTimings {  // seconds, wall clock
 struct SampleStats {
     std::size_t ibp_count = 0, sbp_count = 0, gp_count = 0;
     std::size_t triangles = 0, boundary_edges = 0;
+    std::size_t geometry_triangles = 0;  // of the mesh the GPs are the vertices of (refined)
     bool closed = false;
     bool flipped = false;       // the mesh had negative signed volume and was re-oriented
     double mesh_volume = 0;     // signed volume after orientation
@@ -57,8 +63,9 @@ struct SolidSample {
     double spacing = 0;         // r0
     double support_radius = 0;  // h
     InnerParticles ibp;
-    SurfaceParticles sbp;
-    GeometryLinks gp;
+    SurfaceParticles sbp;  // triangles and weights refer to `geometry`
+    GeometryLinks gp;      // the vertices of `geometry`
+    TriangleMesh geometry;  // the mesh oriented outward, refined (SampleOptions::geometry_max_edge)
     SampleStats stats;
     SampleTimings timings;
 };

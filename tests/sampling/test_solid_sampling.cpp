@@ -107,7 +107,7 @@ TEST_CASE("sphere of radius 10 r0: IBP volume, no IBP outside, coverage, normals
         REQUIRE(s.sbp.normals[i].dot(s.sbp.positions[i].normalized()) > 0.99);
         REQUIRE(std::abs(s.sbp.positions[i].norm() - R) < 0.01 * R);
     }
-    check_sbp_embedding(sphere, s.sbp, r0);
+    check_sbp_embedding(s.geometry, s.sbp, r0);
     // The thinning: no two SBPs (all face outward here) closer than 0.5 r0, so about 2.6 per r0²
     // (docs/sampling.md) and never more than a hexagonal packing at 0.5 r0 allows (4.6 per r0²);
     // at least the 1.54 per r0² that covering at 0.5 r0 needs.
@@ -202,19 +202,24 @@ TEST_CASE("GP links: the IBPs within h with cubic-spline weights") {
     const double r0 = 0.1, h = 0.25;
     const TriangleMesh mesh = make_torus(0.6, 0.3, 24, 12);
     const SolidSample s = sample_solid(mesh, r0, h);
-    REQUIRE(s.gp.count() == mesh.vertices.size());
+    // The GPs: the vertices of the sampler's mesh, refined so that no edge exceeds r0 (the
+    // torus's own vertices first).
+    const TriangleMesh& geometry = s.geometry;
+    REQUIRE(s.gp.count() == geometry.vertices.size());
+    REQUIRE(s.gp.count() > mesh.vertices.size());
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) REQUIRE(geometry.vertices[v] == mesh.vertices[v]);
     CHECK(cubic_spline_w(0.0, h) == doctest::Approx(8.0 / (M_PI * h * h * h)));
     CHECK(cubic_spline_w(h, h) == 0.0);
     CHECK(cubic_spline_w(0.5 * h, h) == doctest::Approx(8.0 / (M_PI * h * h * h) * 0.25));
     for (std::size_t g = 0; g < s.gp.count(); ++g) {
         std::vector<int> expected;
         for (std::size_t p = 0; p < s.ibp.count(); ++p)
-            if ((s.ibp.positions[p] - mesh.vertices[g]).norm() < h) expected.push_back(int(p));
+            if ((s.ibp.positions[p] - geometry.vertices[g]).norm() < h) expected.push_back(int(p));
         const std::vector<int> got(s.gp.ibp.begin() + s.gp.offsets[g], s.gp.ibp.begin() + s.gp.offsets[g + 1]);
         if (expected.empty()) continue;  // orphan: linked to its nearest IBP
         REQUIRE(got == expected);
         for (int e = s.gp.offsets[g]; e < s.gp.offsets[g + 1]; ++e) {
-            const double r = (s.ibp.positions[std::size_t(s.gp.ibp[std::size_t(e)])] - mesh.vertices[g]).norm();
+            const double r = (s.ibp.positions[std::size_t(s.gp.ibp[std::size_t(e)])] - geometry.vertices[g]).norm();
             REQUIRE(s.gp.weight[std::size_t(e)] == doctest::Approx(cubic_spline_w(r, h)));
             REQUIRE(s.gp.weight[std::size_t(e)] > 0);
         }
@@ -256,7 +261,7 @@ TEST_CASE("spot.obj (closed): IBP volume within 5%, no IBP outside") {
     CHECK(std::abs(s.stats.ibp_volume - s.stats.mesh_volume) <= 0.05 * s.stats.mesh_volume);
     CHECK(border_ibps_outside(spot, s.ibp) == 0);
     CHECK(s.stats.largest_gap <= 0.6 * r0);
-    check_sbp_embedding(spot, s.sbp, r0);
+    check_sbp_embedding(s.geometry, s.sbp, r0);
 }
 
 TEST_CASE("stanford-bunny.obj (open, 223 boundary edges): body filled, no IBP outside") {
@@ -273,7 +278,7 @@ TEST_CASE("stanford-bunny.obj (open, 223 boundary edges): body filled, no IBP ou
     CHECK(std::abs(s.stats.ibp_volume - s.stats.mesh_volume) <= 0.05 * s.stats.mesh_volume);
     CHECK(border_ibps_outside(bunny, s.ibp) == 0);
     CHECK(s.stats.largest_gap <= 0.6 * r0);
-    check_sbp_embedding(bunny, s.sbp, r0);
+    check_sbp_embedding(s.geometry, s.sbp, r0);
 }
 
 TEST_CASE("inside/outside does not depend on the mesh's scale (the ray tracer works in float)") {
