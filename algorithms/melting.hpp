@@ -164,6 +164,7 @@ class PhaseChange {
         // neighbour is missing: that is what decides which may melt.
         const std::vector<std::uint8_t>& type_of_scene = setup.type;
         for (const auto& m : solids.melting_lattices()) {
+            lattice_particles_ += long(m.lattice.size());
             grids_.emplace_back(m.lattice);
             const std::vector<std::uint8_t> ring = lattice_one_ring_counts(m.lattice);
             std::copy(ring.begin(), ring.end(), ring_.begin() + long(m.base));
@@ -185,6 +186,8 @@ class PhaseChange {
     View<const Real> latent() const { return latent_ ? latent_->cview() : View<const Real>{}; }
     // Particles melted since the scene started.
     long melted_total() const { return melted_total_; }
+    // Particles that may melt: every lattice vertex of a melting object (each may become fluid).
+    long lattice_particles() const { return lattice_particles_; }
 
     // One step (the slot map current, this step's temperatures in `temperature`).
     PhaseChangeCounts step(ParticleStore& store, SolidBodies& solids, DeviceArray<Real>& temperature,
@@ -290,6 +293,7 @@ class PhaseChange {
     std::vector<std::uint8_t> alive_;          // host, per IBP slot: still in its object
     std::vector<std::uint8_t> melts_host_;     // host copy of melts_, on steps where something melts
     long melted_total_ = 0;
+    long lattice_particles_ = 0;               // of the melting objects, at the start
     std::vector<std::uint8_t> ring_;           // host, per IBP slot: one-ring neighbours still in it
     std::vector<LatticeIndex> grids_;  // host, per melting object: its lattice's grid
 };

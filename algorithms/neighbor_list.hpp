@@ -69,6 +69,26 @@ class NeighborList {
     // one; the lists read it, so it must stay alive and unsorted until the next build.
     inline void build(const GridView& grid, std::size_t fluid_count, View<const Vec3> position, Real radius,
                       View<std::uint32_t> row_counts);
+    // Room for up to `fluid_capacity` rows as long as the last build's on average, made once at
+    // set-up, so that fluid arriving at run time (emitters, melting) does not reallocate the
+    // lists in the step loop.
+    void reserve(std::size_t fluid_capacity) {
+        const double per_row = last_fluid_count_ > 0 && last_fluid_count_ != std::size_t(-1)
+                                   ? double(next_layout_slots_) / double(last_fluid_count_)
+                                   : double(4 * kRowSlack);
+        const std::size_t rows = offsets_.size() > 0 ? offsets_.size() - 1 : 0, bounds = boundary_begin_.size();
+        offsets_.resize(fluid_capacity + 1);
+        boundary_begin_.resize(fluid_capacity);
+        offsets_.resize(rows + 1);  // the sizes back; the capacity stays
+        boundary_begin_.resize(bounds);
+        const auto slots = static_cast<std::uint64_t>(per_row * 1.25 * double(fluid_capacity)) + 1;
+        check_slots(slots);
+        if (slots > indices_.capacity()) {
+            const std::size_t used = indices_.size();
+            indices_.resize(slots);
+            indices_.resize(used);
+        }
+    }
     NeighborListView view() const {
         return NeighborListView{offsets_.view().data(), boundary_begin_.view().data(), row_counts_,
                                 indices_.view().data()};

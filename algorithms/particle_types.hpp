@@ -9,6 +9,9 @@ enum ParticleType : std::uint8_t {
     kSurfaceBoundary = 2, // SBP: on a solid's surface
     kInnerBoundary = 3,   // IBP: lattice vertex inside a solid
     kGeometry = 4,        // GP: a vertex of a solid's mesh (rendering only, not in the fluid's sums)
+    // An emitter's fluid particle not emitted yet (emitter.hpp): held in the store from the start
+    // so that emitting allocates nothing; in no sum, never written to frames.
+    kPending = 5,
 };
 inline const char* particle_type_name(int type) {
     switch (type) {
@@ -17,8 +20,9 @@ inline const char* particle_type_name(int type) {
         case kSurfaceBoundary: return "sbp";
         case kInnerBoundary: return "ibp";
         case kGeometry: return "gp";
+        case kPending: return "pending";
     }
     return "unknown";
 }
-constexpr int kParticleTypeCount = 5;
+constexpr int kParticleTypeCount = 6;
 }  // namespace mw

@@ -160,6 +160,24 @@ struct SolidSetup {
     std::vector<Vec3> rest_vertices;
 };
 
+// The most emitters a scene may have: each step's are passed to the release kernel by value.
+constexpr std::size_t kMaxEmitters = 16;
+
+// A fluid emitter (emitter.hpp): a disc that releases a layer of fluid particles every r0 / speed
+// seconds from `start` on, `layers` layers in all. Its particles are in the setup from the start,
+// of type kPending, at indices [first, first + layers * offsets.size()), layer by layer.
+struct EmitterSetup {
+    std::string name;
+    Vec3 center{0, 0, 0};     // of the disc, m
+    Vec3 direction{0, 1, 0};  // unit: the particles' velocity is speed * direction
+    Real speed = 1;           // m/s
+    double start = 0;         // s: the first layer leaves at start
+    std::uint32_t layers = 0;
+    std::vector<Vec3> offsets;  // one layer's particles relative to the centre, in the disc's plane
+    std::uint32_t first = 0;    // index of its first particle in the setup's lists
+    Real temperature = 20;      // °C, with params.heat
+};
+
 // Initial particles, every type in one list (the store keeps one list too).
 struct SimulationSetup {
     SimulationParams params;
@@ -168,6 +186,7 @@ struct SimulationSetup {
     std::vector<std::uint8_t> type;
     std::vector<std::int32_t> object;  // -1 for fluid and domain walls; static boxes, then objects
     std::vector<SolidSetup> solids;
+    std::vector<EmitterSetup> emitters;
     // Initial temperature of every particle, °C (any consistent unit), with params.heat only:
     // empty otherwise.
     std::vector<Real> temperature;
@@ -197,6 +216,7 @@ struct StepReport {
     int heat_substeps = 0;  // the heat stage's sub-steps this step (heat.hpp); 0 without it
     double heat_content = 0;  // Σ M T over the conducting particles after the step, J (T in °C; heat.hpp); 0 without it
     long melted = 0;  // particles melted since the scene started (melting.hpp); 0 without a melting object
+    long emitted = 0;  // particles emitted since the scene started (emitter.hpp); 0 without an emitter
     int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged or ran out of iterations
     bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
     bool unconverged = false;  // the last try ran out of iterations above η (or eta_max), without diverging

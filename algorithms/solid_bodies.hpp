@@ -153,10 +153,12 @@ class SolidBodies {
         }
         // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
         // forces act through the regions (lsm.hpp, LsmData::forces).
-        // A melting object makes fluid of its own (melting.hpp).
+        // A melting object makes fluid of its own (melting.hpp), and an emitter brings some
+        // (emitter.hpp).
         const bool any_fluid =
             std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end() ||
-            std::any_of(setup.solids.begin(), setup.solids.end(), [](const SolidSetup& o) { return o.melts(); });
+            std::any_of(setup.solids.begin(), setup.solids.end(), [](const SolidSetup& o) { return o.melts(); }) ||
+            !setup.emitters.empty();
         if (setup.params.two_way_coupling && any_fluid) {
             const SurfaceShares shares = surface_shares(L);
             share_offsets_.upload(shares.offsets);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "algorithms/coupling.hpp"
+#include "algorithms/emitter.hpp"
 #include "algorithms/heat.hpp"
 #include "algorithms/melting.hpp"
 #include "algorithms/interface_tension.hpp"
@@ -39,6 +40,9 @@ class BackendSimulation final : public Simulation {
         // 1. Neighbour search: sort moving particles by cell, permute every field, cell ranges.
         timers_.start(kNeighbors);
         ranges_ = grid_.build(store_);
+        // The last step's emitted particles are in the fluid range now, no longer inactive.
+        inactive_by_design_ -= emitted_since_sort_;
+        emitted_since_sort_ = 0;
         if (solids_.active()) solids_.update_slot_map(store_);  // slot -> store index after the sort
         const std::size_t fluid_count = ranges_.fluid_end;
         const GridView grid = grid_.view();
@@ -216,6 +220,18 @@ class BackendSimulation final : public Simulation {
             timers_.stop(kMelting);
         }
 
+        // 9. Emitters (emitter.hpp): the layers due by the step's end leave their discs as fluid
+        //    (the next step's sort moves them to the fluid's range).
+        if (has_emitters_) {
+            timers_.start(kEmit);
+            const long released =
+                emitters_.step(store_, ranges_.solid_end, time_ + dt, params_.gravity, fluid_.rest_density, temperature_);
+            counts_.by_type[kFluid] += released;
+            counts_.by_type[kPending] -= released;
+            emitted_since_sort_ += released;
+            timers_.stop(kEmit);
+        }
+
         time_ += dt;
         ++step_;
         if (motion.first_bad != 0xffffffffu) report_non_finite(motion.first_bad);
@@ -226,6 +242,7 @@ class BackendSimulation final : public Simulation {
         report_.heat_substeps = has_heat_ ? heat_.last_substeps() : 0;
         report_.heat_content = has_heat_ ? heat_.last_content() : 0.0;
         report_.melted = has_melting_ ? melting_.melted_total() : 0;
+        report_.emitted = has_emitters_ ? emitters_.released_total() : 0;
         report_.diverged = outcome == PcisphOutcome::kDiverged;
         report_.unconverged = outcome == PcisphOutcome::kOutOfIterations;
         report_.solid_kinetic_energy = solid_motion.kinetic_energy;
@@ -234,6 +251,8 @@ class BackendSimulation final : public Simulation {
         // fluid's: a solid crossing resting fluid must not jump more than cfl r0 into it. (Its
         // IBPs' speed stands for its SBPs' and GPs', which are interpolated from them.)
         last_max_speed_ = std::max(report_.max_speed, report_.solid_max_speed);
+        // ... and an emitter's new layers (released at its speed) too.
+        if (has_emitters_) last_max_speed_ = std::max(last_max_speed_, emitters_.fastest_after(time_));
     }
 
     const StepReport& last_report() const override { return report_; }
@@ -251,7 +270,7 @@ class BackendSimulation final : public Simulation {
                pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
                contact_boxes_.bytes() + contact_objects_.bytes() + contact_object_distances_.bytes() +
                impulse_per_weight_.bytes() + fluid_near_solid_.bytes() + heat_.bytes() + melting_.bytes() +
-               backend_scratch_bytes();
+               emitters_.bytes() + backend_scratch_bytes();
     }
     double time() const override { return time_; }
     int heat_substeps_needed(double dt) const override { return has_heat_ ? heat_.substeps_needed(dt) : 0; }
@@ -334,11 +353,12 @@ class BackendSimulation final : public Simulation {
         kIntegrate,
         kSolidContact,
         kMelting,
+        kEmit,
         kStageCount
     };
     static constexpr const char* kStageNames[kStageCount] = {
         "neighbors", "solid_volumes", "viscosity", "interface_tension", "pcisph", "heat",
-        "coupling",  "lsm",           "integrate", "solid_contact",     "melting"};
+        "coupling",  "lsm",           "integrate", "solid_contact",     "melting", "emit"};
 
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
                      const MotionSummary& motion) {
@@ -436,8 +456,11 @@ class BackendSimulation final : public Simulation {
     HeatConduction heat_;
     bool has_melting_ = false;  // an object melts (melting.hpp)
     PhaseChange melting_;
+    bool has_emitters_ = false;  // fluid emitters (emitter.hpp)
+    FluidEmitters emitters_;
+    long emitted_since_sort_ = 0;  // released at the end of the last step: still in the inactive range
     ParticleCounts counts_;
-    long inactive_by_design_ = 0;  // GPs: sorted with the inactive group but not lost
+    long inactive_by_design_ = 0;  // GPs and pending particles: sorted with the inactive group but not lost
     double time_ = 0;
     long step_ = 0;
     double last_max_speed_ = 0;
@@ -470,10 +493,11 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
         velocity[k] = setup.velocity[i];
         type[k] = setup.type[i];
         object[k] = setup.object[i];
-        if (type[k] > kGeometry) throw InputError("simulation setup: unknown particle type " + std::to_string(type[k]));
+        if (type[k] >= kParticleTypeCount)
+            throw InputError("simulation setup: unknown particle type " + std::to_string(type[k]));
         if (type[k] != kStaticBoundary) ++moving;
         ++counts_.by_type[type[k]];
-        if (type[k] == kGeometry) ++inactive_by_design_;
+        if (type[k] == kGeometry || type[k] == kPending) ++inactive_by_design_;
         if (!is_finite(position[k]) || !is_finite(velocity[k]))
             throw InputError("simulation setup: particle " + std::to_string(i) +
                              " has a non-finite position or velocity");
@@ -523,8 +547,10 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     }
     melting_.init(setup, store_, solids_);
     has_melting_ = melting_.active();
-    // A scene whose objects melt gains fluid: its fluid stages run from the start.
-    const bool holds_fluid = counts_.by_type[kFluid] > 0 || has_melting_;
+    emitters_.init(setup, fp.spacing);
+    has_emitters_ = emitters_.active();
+    // A scene whose objects melt, or with an emitter, gains fluid: its fluid stages run from the start.
+    const bool holds_fluid = counts_.by_type[kFluid] > 0 || has_melting_ || has_emitters_;
 
     // The grid covers the domain, its walls and one support radius more; fluid that leaves it is
     // counted as lost.
@@ -620,13 +646,19 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     if (has_fluid_) active_stages_.push_back(kIntegrate);
     if (has_solid_contact_) active_stages_.push_back(kSolidContact);
     if (has_melting_) active_stages_.push_back(kMelting);
+    if (has_emitters_) active_stages_.push_back(kEmit);
 
     // One neighbour build now, so that every per-step buffer (sort keys, lists) is allocated
     // before the first step and device_bytes() is the steady-state figure `info` reports.
     ranges_ = grid_.build(store_);
     if (solids_.active()) solids_.update_slot_map(store_);
-    if (use_lists_)
+    if (use_lists_) {
         lists_.build(grid_.view(), ranges_.fluid_end, store_.position.cview(), fluid_.kernel.h, neighbor_count_->view());
+        // Fluid that arrives at run time gets rows without reallocating: every pending particle,
+        // and every lattice particle of a melting object.
+        const long arriving = counts_.by_type[kPending] + (has_melting_ ? melting_.lattice_particles() : 0);
+        if (arriving > 0) lists_.reserve(ranges_.fluid_end + std::size_t(arriving));
+    }
     // The heat's sub-steps from the particles as they start: the solids' g can exceed a fluid
     // lattice's (heat.hpp, calibrate).
     if (has_heat_) {
@@ -645,10 +677,11 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
     }
     if (solids_.active()) solids_.summary(store_);
 
-    // The first CFL step uses the initial speeds.
+    // The first CFL step uses the initial speeds, and the emitters'.
     double max_speed2 = 0;
     for (std::size_t k = 0; k < moving; ++k) max_speed2 = std::max(max_speed2, double(norm2(velocity[k])));
     last_max_speed_ = std::sqrt(max_speed2);
+    if (has_emitters_) last_max_speed_ = std::max(last_max_speed_, emitters_.fastest_after(0));
 }
 
 template <class Kernel>
@@ -694,6 +727,7 @@ template <class Kernel>
 void BackendSimulation<Kernel>::save_state(StateArchive& out) const {
     store_.save(out);
     solids_.save(out);
+    emitters_.save(out);
     step_size_.save(out);
     out.put_value("time", time_);
     out.put_value("step", step_);
@@ -721,6 +755,7 @@ void BackendSimulation<Kernel>::load_state(const StateArchive& in) {
     if (neighbor_count_ && !in.has("store.neighbor_count")) neighbor_count_->fill(0);
     solids_.load(in);
     melting_.load(store_, solids_);  // the slots left, and their regions, from the loaded slots
+    emitters_.load(in);
     step_size_.load(in);
     time_ = in.get_value<double>("time");
     step_ = in.get_value<long>("step");
@@ -732,7 +767,10 @@ void BackendSimulation<Kernel>::load_state(const StateArchive& in) {
         if (t >= kParticleTypeCount) throw InputError("checkpoint: unknown particle type " + std::to_string(t));
         ++counts_.by_type[t];
     }
-    inactive_by_design_ = counts_.by_type[kGeometry];
+    inactive_by_design_ = counts_.by_type[kGeometry] + counts_.by_type[kPending];
+    emitted_since_sort_ = 0;
+    if (counts_.by_type[kPending] != emitters_.capacity() - emitters_.released_total())
+        throw InputError("checkpoint: its pending particles do not match its emitters' released layers");
     report_ = StepReport{};
     report_.step = step_;
     report_.time = time_;

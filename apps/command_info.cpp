@@ -67,6 +67,13 @@ int command_info(int argc, char** argv) {
         if (scene.params.heat.enabled)  // the sub-steps the largest step needs, before heat.max_substeps
             j["heat_substeps_needed"] = probe->heat_substeps_needed(double(solver.dt));
         j["frames"] = frames;
+        if (!setup.emitters.empty()) {
+            SceneJson list = SceneJson::array();
+            for (const EmitterSetup& e : setup.emitters)
+                list.push_back({{"name", e.name}, {"per_layer", e.offsets.size()}, {"layers", e.layers},
+                                {"particles", std::size_t(e.layers) * e.offsets.size()}});
+            j["emitters"] = list;
+        }
         j["scene"] = scene.resolved;
         std::printf("%s\n", j.dump(2, ' ', false, SceneJson::error_handler_t::replace).c_str());
         return 0;
@@ -75,7 +82,8 @@ int command_info(int argc, char** argv) {
     std::printf("scene       %s (%s)\n", scene.name.empty() ? "(unnamed)" : scene.name.c_str(), scene.source.c_str());
     std::printf("particles  ");
     for (int t = 0; t < kParticleTypeCount; ++t)
-        std::printf(" %s %s |", particle_type_name(t), with_thousands(counts.by_type[t]).c_str());
+        if (t != kPending || counts.by_type[t] > 0)  // pending: only where an emitter holds some
+            std::printf(" %s %s |", particle_type_name(t), with_thousands(counts.by_type[t]).c_str());
     std::printf(" total %s\n", with_thousands(counts.total()).c_str());
     if (carved_fluid > 0)
         std::printf("carved      %s fluid particles left out where static boxes and objects stand (closer than "
@@ -159,7 +167,7 @@ int command_info(int argc, char** argv) {
     // Two-way coupling: whether the moving objects feel the fluid (docs/coupling.md).
     const long moving_objects = std::count_if(scene.objects.begin(), scene.objects.end(),
                                               [](const SceneObject& o) { return o.kind != SolidKind::kStatic; });
-    if (moving_objects && !scene.fluid_blocks.empty()) {
+    if (moving_objects && scene.has_fluid()) {
         if (scene.params.two_way_coupling)
             std::printf("coupling    two-way (coupling.two_way): the fluid's pressure%s acts back on %ld moving "
                         "object(s), through their LSM regions\n",
@@ -188,9 +196,22 @@ int command_info(int argc, char** argv) {
         if (with_tension)
             std::printf("            interface tension (Eq. 9) between the fluid and %ld object(s)\n", with_tension);
     }
+    // Emitters (algorithms/emitter.hpp): what each releases, and when.
+    for (std::size_t k = 0; k < setup.emitters.size(); ++k) {
+        const EmitterSetup& e = setup.emitters[k];
+        const double interval = double(f.spacing) / double(e.speed);
+        const double count = double(e.layers) * double(e.offsets.size());
+        // Each particle stands for a lattice cell r0³ of fluid at rest.
+        std::printf("%s %s: %zu particles a layer at %g m/s, a layer every %.4g s from t=%g s, %s layers "
+                    "(%s particles, %.4g m3 at rest; the last at t=%.4g s)\n",
+                    k ? "           " : "emitters   ", e.name.c_str(), e.offsets.size(), double(e.speed), interval,
+                    e.start, with_thousands(long(e.layers)).c_str(), with_thousands(long(count)).c_str(),
+                    count * double(f.spacing) * double(f.spacing) * double(f.spacing),
+                    e.start + double(e.layers - 1) * interval);
+    }
     // Heat conduction (docs/heat.md): who conducts, and the Fourier number that sets its sub-steps.
     if (scene.params.heat.enabled) {
-        const std::string who = (scene.fluid_blocks.empty() ? std::string("") : std::string("the fluid and ")) +
+        const std::string who = (!scene.has_fluid() ? std::string("") : std::string("the fluid and ")) +
                                 std::to_string(moving_objects) + " moving object(s)";
         std::printf("heat        conduction on (heat.enabled) among %s; walls, static boxes and static objects are "
                     "adiabatic; Fourier number alpha dt / r0^2 up to %.3g at the largest step: %d sub-step(s) a "

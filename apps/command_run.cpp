@@ -243,11 +243,13 @@ int command_run(int argc, char** argv) {
         // Carving changes how much fluid a scene holds: say so where the counts are given.
         const std::string carved =
             carved_fluid > 0 ? "; " + with_thousands(carved_fluid) + " fluid carved out where solids stand" : "";
-        std::fprintf(stderr, "meltwater: %s (%s): %s particles (%s fluid, %s boundary%s) on %s [%s], %s; output in %s\n",
+        const std::string pending =
+            c.by_type[kPending] > 0 ? ", " + with_thousands(c.by_type[kPending]) + " to be emitted" : "";
+        std::fprintf(stderr, "meltwater: %s (%s): %s particles (%s fluid%s, %s boundary%s) on %s [%s], %s; output in %s\n",
                      scene.name.empty() ? "scene" : scene.name.c_str(), scene.source.c_str(),
-                     with_thousands(c.total()).c_str(), with_thousands(c.by_type[kFluid]).c_str(),
-                     with_thousands(c.total() - c.by_type[kFluid]).c_str(), carved.c_str(), summary.backend.c_str(),
-                     summary.device.c_str(), stop, out_dir.c_str());
+                     with_thousands(c.total()).c_str(), with_thousands(c.by_type[kFluid]).c_str(), pending.c_str(),
+                     with_thousands(c.total() - c.by_type[kFluid] - c.by_type[kPending]).c_str(), carved.c_str(),
+                     summary.backend.c_str(), summary.device.c_str(), stop, out_dir.c_str());
         if (resume)
             std::fprintf(stderr, "meltwater: resuming from %s: step %ld, t = %.6g s (written on %s)\n",
                          resume_path.c_str(), resume->step, resume->time, resume->backend.c_str());
@@ -413,7 +415,7 @@ int command_run(int argc, char** argv) {
     const std::string shown = std::filesystem::absolute(out_dir, ec).lexically_normal().string();
     // The fluid's figures mean nothing in a scene without fluid (all zero): say so instead.
     char fluid_figures[160] = "no fluid";
-    if (summary.particles.by_type[kFluid] > 0 || stats.has_melting())
+    if (summary.particles.by_type[kFluid] > 0 || stats.has_melting() || stats.has_emitters())
         std::snprintf(fluid_figures, sizeof fluid_figures, "density error avg %.3g%% max %.3g%%, %.1f iterations/step",
                       100 * stats.density_error_avg(), 100 * stats.density_error_max(), stats.iterations_avg());
     std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",

@@ -83,15 +83,32 @@ std::string FrameWriter::particles_name(int index) {
 std::string FrameWriter::write(int index, const HostParticles& p, double time) {
     const std::string name = particles_name(index);
     const std::string path = frames_dir_ + "/" + name;
+    // An emitter's particles not released yet are not in the scene: left out, so a frame holds
+    // what has been emitted by its time (frames of a scene with emitters grow).
+    const bool pending = std::find(p.type.begin(), p.type.end(), std::uint8_t(kPending)) != p.type.end();
+    HostParticles released;
+    if (pending) {
+        for (std::size_t i = 0; i < p.type.size(); ++i) {
+            if (p.type[i] == kPending) continue;
+            released.position.push_back(p.position[i]);
+            released.velocity.push_back(p.velocity[i]);
+            released.density.push_back(p.density[i]);
+            released.pressure.push_back(p.pressure[i]);
+            released.type.push_back(p.type[i]);
+            released.object.push_back(p.object[i]);
+            if (!p.temperature.empty()) released.temperature.push_back(p.temperature[i]);
+        }
+    }
+    const HostParticles& shown = pending ? released : p;
     std::vector<VtuArray> arrays;
-    arrays.push_back(VtuArray::vector3("velocity", p.velocity));
-    arrays.push_back(VtuArray::scalar("density", to_floats(p.density)));
-    arrays.push_back(VtuArray::scalar("pressure", to_floats(p.pressure)));
-    arrays.push_back(VtuArray::uint8("type", p.type));
-    arrays.push_back(VtuArray::int32("object", p.object));
-    if (!p.temperature.empty()) arrays.push_back(VtuArray::scalar("temperature", to_floats(p.temperature)));
-    write_vtu(path, p.position, arrays);
-    write_objects(index, p);
+    arrays.push_back(VtuArray::vector3("velocity", shown.velocity));
+    arrays.push_back(VtuArray::scalar("density", to_floats(shown.density)));
+    arrays.push_back(VtuArray::scalar("pressure", to_floats(shown.pressure)));
+    arrays.push_back(VtuArray::uint8("type", shown.type));
+    arrays.push_back(VtuArray::int32("object", shown.object));
+    if (!shown.temperature.empty()) arrays.push_back(VtuArray::scalar("temperature", to_floats(shown.temperature)));
+    write_vtu(path, shown.position, arrays);
+    write_objects(index, p);  // the objects' GPs by their scene index, in the whole list
     ++written_;
     collection_.emplace_back(time, name);
     write_collection();
@@ -146,6 +163,7 @@ StatsTable::StatsTable(std::vector<std::string> stage_names, bool heat)
     : stages_(std::move(stage_names)),
       heat_(heat),
       melting_(std::find(stages_.begin(), stages_.end(), "melting") != stages_.end()),
+      emitting_(std::find(stages_.begin(), stages_.end(), "emit") != stages_.end()),
       stage_ms_(stages_.size()) {}
 
 void StatsTable::add(const StepReport& r) {
@@ -164,6 +182,11 @@ void StatsTable::add(const StepReport& r) {
         std::snprintf(buffer, sizeof buffer, ",%ld", r.melted);
         csv_rows_ += buffer;
         melted_last_ = r.melted;
+    }
+    if (emitting_) {
+        std::snprintf(buffer, sizeof buffer, ",%ld", r.emitted);
+        csv_rows_ += buffer;
+        emitted_last_ = r.emitted;
     }
     for (std::size_t s = 0; s < stages_.size(); ++s) {
         const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
@@ -188,6 +211,7 @@ std::string StatsTable::header() const {
         "dt_retries,diverged,unconverged";
     if (heat_) h += ",heat_content";
     if (melting_) h += ",melted";
+    if (emitting_) h += ",emitted";
     for (const auto& s : stages_) h += ",ms_" + s;
     return h + ",ms_total";
 }
@@ -292,6 +316,8 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     }
     // Melting: the particles that have left their objects for the fluid by the end of the run.
     if (stats.has_melting() && stats.rows() > 0) j["melted_particles"] = stats.melted_last();
+    // Emitters: the particles released by the end of the run.
+    if (stats.has_emitters() && stats.rows() > 0) j["emitted_particles"] = stats.emitted_last();
     j["device_bytes"] = run.device_bytes;
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;

@@ -89,6 +89,9 @@ class StatsTable {
     // With a melting object (the "melting" stage): a `melted` column, the particles melted so far.
     bool has_melting() const { return melting_; }
     long melted_last() const { return melted_last_; }
+    // With an emitter (the "emit" stage): an `emitted` column, the particles released so far.
+    bool has_emitters() const { return emitting_; }
+    long emitted_last() const { return emitted_last_; }
 
    private:
     std::vector<std::string> stages_;
@@ -96,6 +99,8 @@ class StatsTable {
     double heat_first_ = 0, heat_last_ = 0;
     bool melting_ = false;
     long melted_last_ = 0;
+    bool emitting_ = false;
+    long emitted_last_ = 0;
     std::string earlier_rows_;                   // a resumed run's rows from before its checkpoint
     std::string csv_rows_;                       // every row so far, as written to stats.csv
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]

@@ -359,6 +359,12 @@ std::string describe_box(Vec3 lo, Vec3 hi) {
     return buffer;
 }
 
+std::string describe_point(Vec3 p) {
+    char buffer[96];
+    std::snprintf(buffer, sizeof buffer, "[%.6g, %.6g, %.6g]", double(p.x), double(p.y), double(p.z));
+    return buffer;
+}
+
 bool inside(Vec3 lo, Vec3 hi, Vec3 dlo, Vec3 dhi) {
     const Real eps = Real(1e-6);
     return lo.x >= dlo.x - eps && lo.y >= dlo.y - eps && lo.z >= dlo.z - eps && hi.x <= dhi.x + eps &&
@@ -539,15 +545,24 @@ void read_object_pinned(Section s, SceneObject& o) {
     s.finish();
 }
 
+// `name` of an object or emitter: letters, digits, '_' and '-' only, `fallback` when absent, and
+// none of the names in `taken` (what `plural` lists so far).
+template <class Named>
+std::string read_unique_name(Section& s, const std::string& fallback, const std::vector<Named>& taken,
+                             const std::string& plural, const std::string& why) {
+    const std::string name = s.string("name", fallback);
+    if (name.empty() ||
+        name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") != std::string::npos)
+        s.fail(s.key_path("name"), "use letters, digits, '_' and '-' only" + why + ", got \"" + name + "\"");
+    for (const Named& other : taken)
+        if (other.name == name) s.fail(s.key_path("name"), "two " + plural + " are named \"" + name + "\"");
+    return name;
+}
+
 void read_objects(Section& root, Scene& scene) {
     root.array_of_objects("objects", [&](Section& s, int index) {
         SceneObject o;
-        o.name = s.string("name", "object" + std::to_string(index));
-        if (o.name.empty() || o.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
-                                  std::string::npos)
-            s.fail(s.key_path("name"), "use letters, digits, '_' and '-' only (it names output files), got \"" + o.name + "\"");
-        for (const auto& other : scene.objects)
-            if (other.name == o.name) s.fail(s.key_path("name"), "two objects are named \"" + o.name + "\"");
+        o.name = read_unique_name(s, "object" + std::to_string(index), scene.objects, "objects", " (it names output files)");
         read_object_mesh(s.object("mesh"), o);
         read_object_transform(s.object("transform"), o);
         const std::string kind = s.choice("kind", "elastic", {"elastic", "rigid", "static"});
@@ -581,6 +596,42 @@ void read_objects(Section& root, Scene& scene) {
 void read_run(Section s, Scene& scene) {
     scene.end_time = s.number("end_time", 1.0, Range{0, 1e6, true, false});  // 1e6 s keeps step counts in range
     s.finish();
+}
+
+// After read_run: an emitter's end defaults to the run's.
+void read_emitters(Section& root, Scene& scene) {
+    root.array_of_objects("emitters", [&](Section& s, int index) {
+        if (std::size_t(index) >= kMaxEmitters)
+            s.fail(s.path(), "at most " + std::to_string(kMaxEmitters) + " emitters are supported");
+        SceneEmitter e;
+        e.name = read_unique_name(s, "emitter" + std::to_string(index), scene.emitters, "emitters", "");
+        e.center = s.vec3("center", std::nullopt);
+        const Vec3 direction = s.vec3("direction", std::nullopt);
+        if (!(norm(direction) > 0)) s.fail(s.key_path("direction"), "must not be zero");
+        e.direction = (Real(1) / norm(direction)) * direction;
+        const double radius = s.number("radius", std::nullopt, Range::positive());
+        e.radius = Real(radius);
+        e.speed = Real(s.number("speed", std::nullopt, Range{0, 1000, true, false}));
+        e.start = s.number("start", 0.0, Range{0, 1e6, false, false});
+        e.end = s.number("end", scene.end_time, Range{0, 1e6, true, false});
+        if (!(e.end > e.start))
+            s.fail(s.key_path("end"), "must be later than start (" + format_number(e.start) + " s), got " +
+                                          format_number(e.end));
+        e.temperature = Real(s.number("temperature", double(scene.fluid_temperature), kTemperatureRange));
+        // The disc's particles start r0/2 inside the domain at the most, as a fluid block's do.
+        const Real margin = scene.params.fluid.spacing / 2, reach = e.radius;
+        const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
+        for (int a = 0; a < 3; ++a) {
+            // How far the disc reaches along axis a: radius × sin(angle between the axis and its normal).
+            const Real d = (&e.direction.x)[a];
+            const Real extent = reach * std::sqrt(std::max(Real(0), Real(1) - d * d));
+            const Real c = (&e.center.x)[a];
+            if (c - extent < (&lo.x)[a] + margin - Real(1e-6) * margin || c + extent > (&hi.x)[a] - margin + Real(1e-6) * margin)
+                s.fail(s.path(), "the disc (center " + describe_point(e.center) + ", radius " + format_number(radius) +
+                                     ") must lie inside the domain " + describe_box(lo, hi) + ", r0/2 from its faces");
+        }
+        scene.emitters.push_back(e);
+    });
 }
 
 void read_output(Section s, Scene& scene) {
@@ -776,7 +827,7 @@ std::string Scene::kernel_warning() const {
 }
 
 double Scene::largest_heat_diffusivity() const {
-    double largest = fluid_blocks.empty() ? 0.0 : double(params.heat.fluid_diffusivity);
+    double largest = !has_fluid() ? 0.0 : double(params.heat.fluid_diffusivity);
     for (const SceneObject& o : objects)
         if (o.kind != SolidKind::kStatic) largest = std::max(largest, double(o.thermal_diffusivity));
     return largest;
@@ -828,12 +879,13 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_fluid_blocks(root, scene);
     read_static_boxes(root, scene);
     read_objects(root, scene);
-    if (scene.fluid_blocks.empty() && scene.objects.empty()) {
+    read_run(root.object("run"), scene);
+    read_emitters(root, scene);
+    if (scene.fluid_blocks.empty() && scene.objects.empty() && scene.emitters.empty()) {
         const std::string hint = root.misspelling_hint("fluid_blocks");
-        root.fail("fluid_blocks", "at least one fluid block (or one object) is needed" +
+        root.fail("fluid_blocks", "at least one fluid block (or one object, or one emitter) is needed" +
                                       (hint.empty() ? root.misspelling_hint("objects") : hint));
     }
-    read_run(root.object("run"), scene);
     read_output(root.object("output"), scene);
     root.finish();
     scene.resolved = out;

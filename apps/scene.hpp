@@ -53,6 +53,18 @@ struct SceneObject {
     Vec3 pin_point{}, pin_normal{};     // half-space: IBPs with (x - point)·normal < 0 are pinned
 };
 
+// A fluid emitter (docs/scenes.md, "emitters"; algorithms/emitter.hpp): a disc releasing layers
+// of fluid at `speed` along `direction` from `start` to `end`.
+struct SceneEmitter {
+    std::string name;
+    Vec3 center{0, 0, 0};
+    Vec3 direction{0, -1, 0};  // unit
+    Real radius = 0.05;
+    Real speed = 1;
+    double start = 0, end = 1;  // s
+    Real temperature = 20;      // °C, with heat conduction (fluid.temperature by default)
+};
+
 struct Scene {
     std::string name;
     std::string source;                  // the file it came from, or "built-in default scene"
@@ -72,6 +84,7 @@ struct Scene {
     std::vector<FluidBlock> fluid_blocks;
     std::vector<StaticBox> static_boxes;
     std::vector<SceneObject> objects;
+    std::vector<SceneEmitter> emitters;
     std::string base_dir;  // folder of the scene file ("" for text scenes): mesh paths are relative to it
     double end_time = 1.0;  // run.end_time, s
     double fps = 30;        // output.fps: frames per simulated second
@@ -79,6 +92,8 @@ struct Scene {
     SceneJson resolved;  // every key with its value, defaults filled in, overrides applied
 
     Real boundary_spacing() const { return boundary_spacing_factor * params.fluid.spacing; }
+    // Whether the scene has fluid from the start or from an emitter (melting objects aside).
+    bool has_fluid() const { return !fluid_blocks.empty() || !emitters.empty(); }
     // How far outside the domain faces the walls' first layer goes (sampling/wall_gap.hpp), m.
     Real wall_gap() const;
     bool writes_vtu() const;

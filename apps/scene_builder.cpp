@@ -8,6 +8,7 @@
 #include "algorithms/lsm_regions.hpp"
 #include "backend/errors.hpp"
 #include "sampling/box_particles.hpp"
+#include "sampling/disc_lattice.hpp"
 #include "sampling/inside_outside.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
@@ -141,7 +142,18 @@ ParticleEstimate estimate_particles(const Scene& scene) {
     if (scene.walls)
         n.boundary += surface_count(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers);
     for (const auto& b : scene.static_boxes) n.boundary += surface_count(b.min, b.max, rb, b.layers);
+    for (const auto& e : scene.emitters) {
+        const double disc = std::max(1.0, M_PI * double(e.radius) * double(e.radius) / (r0 * r0));
+        n.fluid += disc * std::ceil((e.end - e.start) * double(e.speed) / r0);
+    }
     return n;
+}
+
+std::uint32_t emitter_layers(const SceneEmitter& e, double r0) {
+    // Layer k leaves at start + k r0 / speed: those before `end` (one due within 1e-4 of an
+    // interval before it counts as due at it: r0 and the speed are single precision).
+    const double layers = std::ceil((e.end - e.start) * double(e.speed) / r0 - 1e-4);
+    return static_cast<std::uint32_t>(std::max(1.0, std::min(layers, 4e9)));
 }
 
 long estimate_particle_count(const Scene& scene) {
@@ -248,7 +260,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             // correction is on and there is fluid to stop).
             const bool any_melts = std::any_of(scene.objects.begin(), scene.objects.end(),
                                                [](const SceneObject& other) { return other.melts(); });
-            if (o.kind == SolidKind::kStatic && scene.params.wall_correction && (!scene.fluid_blocks.empty() || any_melts))
+            if (o.kind == SolidKind::kStatic && scene.params.wall_correction && (scene.has_fluid() || any_melts))
                 add_static_object_distance(setup, object.mesh, scene.params.fluid.spacing, sealed_faces(scene));
             for (std::size_t i = first; check_overlaps && i < first + inner; ++i) {
                 const Vec3 x = setup.position[i];
@@ -277,6 +289,29 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         }
     }
     if (carved_fluid) *carved_fluid = carved;
+    // The emitters' particles, pending until their layer leaves (algorithms/emitter.hpp), last so
+    // that nothing above renumbers them.
+    for (std::size_t k = 0; k < scene.emitters.size(); ++k) {
+        const SceneEmitter& e = scene.emitters[k];
+        EmitterSetup emitter;
+        emitter.name = e.name;
+        emitter.center = e.center;
+        emitter.direction = e.direction;
+        emitter.speed = e.speed;
+        emitter.start = e.start;
+        emitter.temperature = e.temperature;
+        emitter.offsets = disc_lattice(e.direction, e.radius, r0);
+        emitter.layers = emitter_layers(e, r0);
+        emitter.first = static_cast<std::uint32_t>(setup.position.size());
+        const double count = double(emitter.layers) * double(emitter.offsets.size());
+        if (double(setup.position.size()) + count > double(kMaxSceneParticles))
+            throw InputError(scene.source + ": emitters[" + std::to_string(k) + "] (" + e.name + ") would release " +
+                             std::to_string(static_cast<long>(count)) + " particles, more than the scene allows (" +
+                             std::to_string(kMaxSceneParticles) + " in all); shorten it, slow it or narrow it");
+        append(setup, std::vector<Vec3>(std::size_t(count), e.center), Vec3{0, 0, 0}, kPending, -1);
+        started_at(e.temperature);
+        setup.emitters.push_back(std::move(emitter));
+    }
     return setup;
 }
 

@@ -23,6 +23,8 @@ struct ParticleEstimate {
     double total() const { return fluid + boundary; }
 };
 ParticleEstimate estimate_particles(const Scene& scene);
+// Layers an emitter releases (each r0 / speed after the last, from start until end).
+std::uint32_t emitter_layers(const SceneEmitter& e, double r0);
 long estimate_particle_count(const Scene& scene);
 
 // The particles of the scene. Fluid is carved out where static boxes and objects stand (see

@@ -265,29 +265,16 @@ TEST_CASE("an ice cube in warm water melts gradually, and what melts joins the w
 }
 
 TEST_CASE("a checkpoint taken mid-melt resumes bitwise where the whole run ends") {
-    const SimulationSetup setup = ice_in_warm_water();
-    const int first = 30, second = 20;
-    const std::unique_ptr<Simulation> whole = create_openmp_simulation(setup, 0);
-    const HostParticles uninterrupted = test::run_steps(*whole, first + second);
-    StateArchive saved;
-    long melted_at_save = 0;
-    {
-        const std::unique_ptr<Simulation> before = create_openmp_simulation(setup, 0);
-        test::run_steps(*before, first);
-        melted_at_save = before->last_report().melted;
-        before->save_state(saved);
-    }
-    const std::unique_ptr<Simulation> resumed = create_openmp_simulation(setup, 0);
-    resumed->load_state(saved);
-    const HostParticles after = test::run_steps(*resumed, second);
-    MESSAGE(melted_at_save << " melted at the checkpoint, " << whole->last_report().melted << " at the end");
-    REQUIRE(melted_at_save > 0);
-    REQUIRE(whole->last_report().melted > melted_at_save);  // melting went on after it
-    CHECK(resumed->last_report().melted == whole->last_report().melted);
-    CHECK(after.type == uninterrupted.type);
-    CHECK(std::memcmp(after.position.data(), uninterrupted.position.data(), after.position.size() * sizeof(Vec3)) == 0);
-    CHECK(std::memcmp(after.temperature.data(), uninterrupted.temperature.data(),
-                      after.temperature.size() * sizeof(Real)) == 0);
+    const test::SplitRun run = test::run_split(ice_in_warm_water(), 30, 20);
+    MESSAGE(run.saved_report.melted << " melted at the checkpoint, " << run.whole_report.melted << " at the end");
+    REQUIRE(run.saved_report.melted > 0);
+    REQUIRE(run.whole_report.melted > run.saved_report.melted);  // melting went on after it
+    CHECK(run.resumed_report.melted == run.whole_report.melted);
+    CHECK(run.resumed.type == run.uninterrupted.type);
+    CHECK(std::memcmp(run.resumed.position.data(), run.uninterrupted.position.data(),
+                      run.resumed.position.size() * sizeof(Vec3)) == 0);
+    CHECK(std::memcmp(run.resumed.temperature.data(), run.uninterrupted.temperature.data(),
+                      run.resumed.temperature.size() * sizeof(Real)) == 0);
 }
 
 TEST_CASE("only elastic objects melt, and only with heat conduction") {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "algorithms/simulation.hpp"
+#include "algorithms/state_archive.hpp"
 #include "algorithms/sph_kernels.hpp"
 #include "apps/scene_builder.hpp"
 #include "backend/backend.hpp"
@@ -102,6 +103,37 @@ inline HostParticles run_steps(Simulation& sim, int steps) {
     HostParticles p;
     sim.download(p);
     return p;
+}
+
+// `setup` run `first + second` steps straight through, and again as `first` steps saved to a
+// state archive and `second` more from a fresh simulation that loaded it: the checkpoint tests'
+// two runs, and the saved state (for tests that tamper with it).
+struct SplitRun {
+    HostParticles uninterrupted, resumed;
+    StepReport whole_report, saved_report, resumed_report;
+    ParticleCounts whole_counts, resumed_counts;
+    StateArchive saved;
+};
+inline SplitRun run_split(const SimulationSetup& setup, int first, int second) {
+    SplitRun out;
+    {
+        const std::unique_ptr<Simulation> whole = create_openmp_simulation(setup, 0);
+        out.uninterrupted = run_steps(*whole, first + second);
+        out.whole_report = whole->last_report();
+        out.whole_counts = whole->counts();
+    }
+    {
+        const std::unique_ptr<Simulation> before = create_openmp_simulation(setup, 0);
+        run_steps(*before, first);
+        out.saved_report = before->last_report();
+        before->save_state(out.saved);
+    }
+    const std::unique_ptr<Simulation> resumed = create_openmp_simulation(setup, 0);
+    resumed->load_state(out.saved);
+    out.resumed = run_steps(*resumed, second);
+    out.resumed_report = resumed->last_report();
+    out.resumed_counts = resumed->counts();
+    return out;
 }
 
 // `setup` run for the same number of steps on OpenMP (at the current thread count), then on CUDA:

@@ -1,0 +1,209 @@
+// Fluid emitters: streams of fluid entering the scene through a disc (the paper's Figs. 1, 8-11
+// pour a stream onto their solids). Each emitter releases a layer of particles, a square lattice
+// at spacing r0 over its disc, every r0 / speed seconds, moving at `speed` along its direction, so
+// that the layers leave r0 apart and the stream starts at the fluid's rest spacing in all three
+// directions: a steady flux of rest density × speed × (the layer's particles × r0²).
+//
+// The particles exist from the start: the scene builder appends every layer an emitter will
+// release as particles of type kPending, which the neighbour grid sorts with the inactive group
+// (after the solids) and no sum reads. Emitting one is a change of type in place, as melting is
+// (the store allows a particle to change type; its id, the index the scene gave it, tells which
+// layer and which point of the disc it is): no allocation, no host copy, one launch on a step that
+// emits and nothing on the others. The next step's sort moves the new fluid into the fluid range.
+//
+// Timing: layer k leaves the disc at t_k = start + k r0 / speed. The stage runs at the end of a
+// step, and a layer due within it is placed where it would be at the step's end, t_k + τ: the
+// disc's point plus speed τ along the direction and g τ²/2, with velocity speed + g τ. So a step
+// longer than r0 / speed releases several layers, each at its own distance: the stream does not
+// depend on the step. Nothing keeps fluid from flowing back over the disc: keep it clear of
+// fluid (docs/scenes.md, "emitters").
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "algorithms/particle_store.hpp"
+#include "algorithms/particle_types.hpp"
+#include "algorithms/simulation.hpp"
+#include "algorithms/state_archive.hpp"
+#include "backend/backend.hpp"
+
+MW_BACKEND_BEGIN
+
+// One emitter's layers to release in this step: ids [first_id, end_id) of its particles.
+struct EmitterWindow {
+    std::uint32_t first_id = 0, end_id = 0;  // this step's
+    std::uint32_t base_id = 0;               // its first particle's id
+    std::uint32_t per_layer = 0;
+    std::uint32_t offsets_begin = 0;         // its layer's points in the shared offsets array
+    Vec3 center{0, 0, 0}, direction{0, 0, 0};
+    Real speed = 0;
+    Real temperature = 0;
+    double start = 0, interval = 0;  // t_k = start + k interval
+};
+struct EmitterWindows {
+    EmitterWindow e[kMaxEmitters];
+    std::uint32_t count = 0;
+};
+
+// What the release kernel writes (store fields; temperature null without heat conduction).
+struct EmissionData {
+    const std::uint32_t* id = nullptr;
+    std::uint8_t* type = nullptr;
+    Vec3* position = nullptr;
+    Vec3* velocity = nullptr;
+    std::int32_t* object = nullptr;
+    Real* density = nullptr;
+    Real* temperature = nullptr;
+    const Vec3* offsets = nullptr;
+    Real rest_density = 0;
+    Vec3 gravity{0, 0, 0};
+    double time_after = 0;  // the step's end, s
+};
+
+// Over the store's particles [begin, end) (the inactive group, where the pending particles are):
+// each pending particle whose id is in a window becomes fluid at its layer's place.
+inline void release_layers(std::size_t begin, std::size_t end, const EmitterWindows windows, const EmissionData d) {
+    parallel_for("emitter_release", end - begin, [=] MW_HD(std::size_t k) {
+        const std::size_t i = begin + k;
+        if (d.type[i] != kPending) return;
+        const std::uint32_t id = d.id[i];
+        for (std::uint32_t w = 0; w < windows.count; ++w) {
+            const EmitterWindow& e = windows.e[w];
+            if (id < e.first_id || id >= e.end_id) continue;
+            const std::uint32_t n = id - e.base_id, layer = n / e.per_layer, point = n % e.per_layer;
+            const Real tau = static_cast<Real>(d.time_after - (e.start + double(layer) * e.interval));
+            d.position[i] = e.center + d.offsets[e.offsets_begin + point] + (e.speed * tau) * e.direction +
+                            (Real(0.5) * tau * tau) * d.gravity;
+            d.velocity[i] = e.speed * e.direction + tau * d.gravity;
+            d.type[i] = kFluid;
+            d.object[i] = -1;
+            d.density[i] = d.rest_density;
+            if (d.temperature) d.temperature[i] = e.temperature;
+            return;
+        }
+    });
+}
+
+// The stage: the emitters' layers, and how many each has released.
+class FluidEmitters {
+   public:
+    // Checks the setup's emitters (their particles must be pending, layer by layer, as
+    // EmitterSetup says) and uploads their layers' points. Throws InputError naming the emitter.
+    void init(const SimulationSetup& setup, Real spacing) {
+        if (setup.emitters.size() > kMaxEmitters)
+            throw InputError("simulation setup: " + std::to_string(setup.emitters.size()) + " emitters, at most " +
+                             std::to_string(kMaxEmitters) + " are supported");
+        std::vector<Vec3> offsets;
+        for (const EmitterSetup& s : setup.emitters) {
+            const std::string name = "simulation setup: emitter \"" + s.name + "\": ";
+            if (!(s.speed > 0) || !std::isfinite(double(s.speed))) throw InputError(name + "speed must be > 0");
+            if (!(std::fabs(double(norm(s.direction)) - 1) < 1e-5)) throw InputError(name + "direction must be a unit vector");
+            if (s.offsets.empty() || s.layers == 0) throw InputError(name + "releases no particle");
+            const std::size_t count = std::size_t(s.layers) * s.offsets.size();
+            if (std::size_t(s.first) + count > setup.type.size())
+                throw InputError(name + "its particles reach past the setup's lists");
+            for (std::size_t i = s.first; i < s.first + count; ++i)
+                if (setup.type[i] != kPending) throw InputError(name + "particle " + std::to_string(i) + " is not pending");
+            EmitterWindow w;
+            w.base_id = w.first_id = w.end_id = s.first;
+            w.per_layer = static_cast<std::uint32_t>(s.offsets.size());
+            w.offsets_begin = static_cast<std::uint32_t>(offsets.size());
+            w.center = s.center;
+            w.direction = s.direction;
+            w.speed = s.speed;
+            w.temperature = s.temperature;
+            w.start = s.start;
+            w.interval = double(spacing) / double(s.speed);
+            emitters_.push_back(w);
+            layers_.push_back(s.layers);
+            offsets.insert(offsets.end(), s.offsets.begin(), s.offsets.end());
+        }
+        released_.assign(emitters_.size(), 0);
+        if (!offsets.empty()) offsets_.upload(offsets);
+    }
+    bool active() const { return !emitters_.empty(); }
+
+    // Releases every layer due by `time_after` (the step's end); returns how many particles.
+    long step(ParticleStore& store, std::size_t inactive_begin, double time_after, Vec3 gravity, Real rest_density,
+              DeviceArray<Real>* temperature) {
+        EmitterWindows windows;
+        long released = 0;
+        for (std::size_t k = 0; k < emitters_.size(); ++k) {
+            const std::uint32_t due = layers_due(k, time_after);
+            if (due <= released_[k]) continue;
+            EmitterWindow w = emitters_[k];
+            w.first_id = w.base_id + released_[k] * w.per_layer;
+            w.end_id = w.base_id + due * w.per_layer;
+            windows.e[windows.count++] = w;
+            released += long(due - released_[k]) * long(w.per_layer);
+            released_[k] = due;
+        }
+        if (windows.count == 0) return 0;
+        EmissionData d;
+        d.id = store.id.cview().data();
+        d.type = store.type.view().data();
+        d.position = store.position.view().data();
+        d.velocity = store.velocity.view().data();
+        d.object = store.object.view().data();
+        d.density = store.density.view().data();
+        d.temperature = temperature ? temperature->view().data() : nullptr;
+        d.offsets = offsets_.cview().data();
+        d.rest_density = rest_density;
+        d.gravity = gravity;
+        d.time_after = time_after;
+        release_layers(inactive_begin, store.moving_count(), windows, d);
+        released_total_ += released;
+        return released;
+    }
+
+    // Particles released since the scene started, and all it will release.
+    long released_total() const { return released_total_; }
+    long capacity() const {
+        long total = 0;
+        for (std::size_t k = 0; k < emitters_.size(); ++k) total += long(layers_[k]) * long(emitters_[k].per_layer);
+        return total;
+    }
+    // The fastest emitter still to release a layer after `time`: the next CFL step must not carry
+    // its new layers more than the CFL distance (0 when none is left).
+    double fastest_after(double time) const {
+        double fastest = 0;
+        for (std::size_t k = 0; k < emitters_.size(); ++k)
+            if (layers_due(k, time) < layers_[k]) fastest = std::max(fastest, double(emitters_[k].speed));
+        return fastest;
+    }
+
+    void save(StateArchive& out) const { out.put("emitters.released_layers", released_); }
+    // After the store is loaded: the layers released so far (its pending particles must match).
+    void load(const StateArchive& in) {
+        if (emitters_.empty()) return;
+        released_ = in.get_sized<std::uint32_t>("emitters.released_layers", emitters_.size());
+        released_total_ = 0;
+        for (std::size_t k = 0; k < emitters_.size(); ++k) {
+            if (released_[k] > layers_[k]) throw InputError("checkpoint: an emitter released more layers than it has");
+            released_total_ += long(released_[k]) * long(emitters_[k].per_layer);
+        }
+    }
+
+    std::size_t bytes() const { return offsets_.bytes(); }
+
+   private:
+    // Layers of emitter k that have left by `time`: t_k <= time for k = 0, 1, ..., at most all.
+    std::uint32_t layers_due(std::size_t k, double time) const {
+        const EmitterWindow& e = emitters_[k];
+        if (time < e.start) return 0;
+        // A layer due at the step's end to rounding counts as due (1e-9 of an interval).
+        const double due = std::floor((time - e.start) / e.interval + 1e-9) + 1;
+        return due >= double(layers_[k]) ? layers_[k] : static_cast<std::uint32_t>(due);
+    }
+
+    std::vector<EmitterWindow> emitters_;  // base ids, layer geometry, timing
+    std::vector<std::uint32_t> layers_;    // per emitter: its layers in all
+    std::vector<std::uint32_t> released_;  // per emitter: layers released so far
+    long released_total_ = 0;
+    DeviceArray<Vec3> offsets_;  // every emitter's layer points, concatenated
+};
+
+MW_BACKEND_END

@@ -1,0 +1,152 @@
+// Fluid emitters (algorithms/emitter.hpp): a layer every r0 / speed, each where its release time
+// puts it; the stream's volume; checkpoints mid-stream; the two backends alike.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "algorithms/state_archive.hpp"
+#include "backend/backend_registry.hpp"
+#include "test_setups.hpp"
+#include "../skip.hpp"
+
+using namespace mw;
+
+namespace {
+
+SimulationSetup setup_of(const std::string& json) { return build_setup(parse_scene_text(json, "emitter test")); }
+
+// A jet in empty space: no gravity, no walls, no viscosity, an oblique direction, fixed steps of
+// 2.5 layers each (2 m/s, r0 = 0.02 m: a layer every 10 ms, steps of 25 ms).
+const char* kFreeJet = R"({
+  "domain": { "min": [0, 0, 0], "max": [2, 2, 1] },
+  "gravity": [0, 0, 0],
+  "fluid": { "spacing": 0.02, "support_radius": 0.04 },
+  "solver": { "dt": 0.025 },
+  "boundary": { "walls": false },
+  "emitters": [ { "name": "jet", "center": [0.2, 0.2, 0.5], "direction": [3, 4, 0], "radius": 0.05,
+                  "speed": 2, "start": 0.01, "end": 0.5 } ],
+  "run": { "end_time": 1 }
+})";
+
+// A tap 0.3 m over the floor of a walled tank, running for 1 s, and the tank settling until 2 s.
+const char* kTank = R"({
+  "domain": { "min": [0, 0, 0], "max": [0.4, 0.6, 0.4] },
+  "fluid": { "spacing": 0.02, "support_radius": 0.04, "viscosity": 0.01 },
+  "solver": { "dt": 0.004, "dt_mode": "cfl" },
+  "emitters": [ { "name": "tap", "center": [0.2, 0.5, 0.2], "direction": [0, -1, 0], "radius": 0.05,
+                  "speed": 1.5, "end": 1.0 } ],
+  "run": { "end_time": 2.0 }
+})";
+
+}  // namespace
+
+TEST_CASE("an emitter releases a layer every r0 / speed, each where and as fast as its release time says") {
+    const SimulationSetup setup = setup_of(kFreeJet);
+    REQUIRE(setup.emitters.size() == 1);
+    const EmitterSetup& jet = setup.emitters[0];
+    const std::size_t per_layer = jet.offsets.size();
+    // A square lattice over the disc of 2.5 r0: the points within it, the centre among them.
+    CHECK(per_layer == 21);
+    CHECK(jet.layers == 49);  // layers at 0.01, 0.02, ... up to but not including 0.5 s
+    for (const Vec3& o : jet.offsets) {
+        REQUIRE(std::fabs(dot(o, jet.direction)) < 1e-6f);
+        REQUIRE(norm(o) <= 0.05f * 1.0001f);
+    }
+    const double r0 = 0.02, speed = 2, interval = r0 / speed, start = 0.01;
+    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    CHECK(sim->counts().by_type[kPending] == long(per_layer * jet.layers));
+    HostParticles p;
+    for (int step = 1; step <= 24; ++step) {
+        sim->step();
+        const double t = sim->time();
+        const long due = t < start ? 0 : std::min<long>(jet.layers, long(std::floor((t - start) / interval + 1e-9)) + 1);
+        CAPTURE(step);
+        REQUIRE(sim->last_report().emitted == due * long(per_layer));
+        REQUIRE(sim->counts().by_type[kFluid] == due * long(per_layer));
+        REQUIRE(sim->counts().by_type[kPending] == long(per_layer * jet.layers) - due * long(per_layer));
+        REQUIRE(sim->last_report().lost_particles == 0);
+        sim->download(p);
+        // Every released particle where its layer's release time puts it, at the jet's velocity:
+        // a lattice at r0 in all three directions is nowhere denser than rest, so nothing pushes.
+        double worst_position = 0, worst_velocity = 0;
+        long fluid = 0;
+        for (std::size_t i = 0; i < p.type.size(); ++i) {
+            if (p.type[i] != kFluid) continue;
+            ++fluid;
+            const std::size_t n = i - jet.first, layer = n / per_layer, point = n % per_layer;
+            const double tau = t - (start + double(layer) * interval);
+            const Vec3 expected = jet.center + jet.offsets[point] + Real(speed * tau) * jet.direction;
+            worst_position = std::max(worst_position, double(norm(p.position[i] - expected)));
+            worst_velocity = std::max(worst_velocity, double(norm(p.velocity[i] - Real(speed) * jet.direction)));
+        }
+        REQUIRE(fluid == due * long(per_layer));
+        CHECK(worst_position < 1e-5);
+        CHECK(worst_velocity < 1e-5);
+        CHECK(sim->last_report().density_error_max < 1e-5);  // rounding
+    }
+    CHECK(sim->counts().by_type[kPending] == 0);  // all 49 layers gone by 0.5 s
+}
+
+TEST_CASE("a stream fills a tank to the height of the volume it released") {
+    // 75 layers of 21 particles (one every 13.3 ms before t = 1 s), each a lattice cell r0³:
+    // 0.0126 m³ over the tank's 0.16 m², a layer 0.0788 m deep, whose particle centres lie at half
+    // that on average.
+    const SimulationSetup setup = setup_of(kTank);
+    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    const long released = long(setup.emitters[0].layers * setup.emitters[0].offsets.size());
+    REQUIRE(released == 1575);
+    while (sim->time() < 2.0) sim->step();
+    CHECK(sim->last_report().emitted == released);
+    CHECK(sim->last_report().lost_particles == 0);
+    HostParticles p;
+    sim->download(p);
+    double mean_height = 0;
+    long fluid = 0;
+    for (std::size_t i = 0; i < p.type.size(); ++i)
+        if (p.type[i] == kFluid) mean_height += double(p.position[i].y), ++fluid;
+    REQUIRE(fluid == released);
+    mean_height /= double(fluid);
+    const double depth = double(released) * 0.02 * 0.02 * 0.02 / (0.4 * 0.4);
+    MESSAGE("mean height " << mean_height << " m against " << depth / 2 << "; top speed at the end "
+                           << sim->last_report().max_speed << " m/s");
+    CHECK(mean_height == doctest::Approx(depth / 2).epsilon(0.05));
+    CHECK(sim->last_report().max_speed < 1.0);  // settling
+}
+
+TEST_CASE("a checkpoint taken mid-stream resumes bitwise where the whole run ends") {
+    const SimulationSetup setup = setup_of(kTank);
+    const test::SplitRun run = test::run_split(setup, 150, 100);
+    MESSAGE(run.saved_report.emitted << " emitted at the checkpoint, " << run.whole_report.emitted << " at the end");
+    REQUIRE(run.saved_report.emitted > 0);
+    REQUIRE(run.whole_report.emitted > run.saved_report.emitted);
+    CHECK(run.resumed_report.emitted == run.whole_report.emitted);
+    CHECK(run.resumed_counts.by_type[kPending] == run.whole_counts.by_type[kPending]);
+    CHECK(run.resumed.type == run.uninterrupted.type);
+    CHECK(std::memcmp(run.resumed.position.data(), run.uninterrupted.position.data(),
+                      run.resumed.position.size() * sizeof(Vec3)) == 0);
+    CHECK(std::memcmp(run.resumed.velocity.data(), run.uninterrupted.velocity.data(),
+                      run.resumed.velocity.size() * sizeof(Vec3)) == 0);
+    // A checkpoint whose released layers disagree with its particles is refused.
+    StateArchive tampered;
+    for (const StateBlock& block : run.saved.blocks())
+        if (block.name != "emitters.released_layers") tampered.add(block);
+    tampered.put("emitters.released_layers", std::vector<std::uint32_t>{1});
+    const std::unique_ptr<Simulation> refused = create_openmp_simulation(setup, 0);
+    CHECK_THROWS_WITH_AS(refused->load_state(tampered), doctest::Contains("pending particles"), InputError);
+}
+
+TEST_CASE("CUDA: a stream fills a tank as on OpenMP") {
+    if (!cuda_backend_info().available) {
+        MW_SKIP("no CUDA device: the cross-backend emitter test needs one");
+        return;
+    }
+    const SimulationSetup setup = setup_of(kTank);
+    const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 150);
+    CHECK(runs.cuda_report.emitted == runs.openmp_report.emitted);
+    CHECK(runs.cuda.type == runs.openmp.type);
+    const double worst = test::largest_position_difference(runs.openmp, runs.cuda);
+    MESSAGE("largest position difference " << worst << " m after 150 steps");
+    CHECK(worst < 1e-4 * 0.6);  // of the domain's size, as the dam break's comparison asks
+}
