@@ -32,9 +32,10 @@
 
 MW_BACKEND_BEGIN
 
-// One emitter's layers to release in this step: ids [first_id, end_id) of its particles.
+// One emitter: its layers' geometry and timing, kept for the run, and, in a step's windows, the
+// ids of its particles to release in that step, [first_id, end_id).
 struct EmitterWindow {
-    std::uint32_t first_id = 0, end_id = 0;  // this step's
+    std::uint32_t first_id = 0, end_id = 0;  // this step's (empty in the kept copy)
     std::uint32_t base_id = 0;               // its first particle's id
     std::uint32_t per_layer = 0;
     std::uint32_t offsets_begin = 0;         // its layer's points in the shared offsets array

@@ -71,7 +71,8 @@ class NeighborList {
                       View<std::uint32_t> row_counts);
     // Room for up to `fluid_capacity` rows as long as the last build's on average, made once at
     // set-up, so that fluid arriving at run time (emitters, melting) does not reallocate the
-    // lists in the step loop.
+    // lists in the step loop. Growing a buffer drops the rows built so far: the next build lays
+    // them out again.
     void reserve(std::size_t fluid_capacity) {
         const double per_row = last_fluid_count_ > 0 && last_fluid_count_ != std::size_t(-1)
                                    ? double(next_layout_slots_) / double(last_fluid_count_)

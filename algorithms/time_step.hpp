@@ -40,9 +40,6 @@ class BackendSimulation final : public Simulation {
         // 1. Neighbour search: sort moving particles by cell, permute every field, cell ranges.
         timers_.start(kNeighbors);
         ranges_ = grid_.build(store_);
-        // The last step's emitted particles are in the fluid range now, no longer inactive.
-        inactive_by_design_ -= emitted_since_sort_;
-        emitted_since_sort_ = 0;
         if (solids_.active()) solids_.update_slot_map(store_);  // slot -> store index after the sort
         const std::size_t fluid_count = ranges_.fluid_end;
         const GridView grid = grid_.view();
@@ -222,13 +219,13 @@ class BackendSimulation final : public Simulation {
 
         // 9. Emitters (emitter.hpp): the layers due by the step's end leave their discs as fluid
         //    (the next step's sort moves them to the fluid's range).
+        long released = 0;  // fluid now, but still among the inactive particles until the next sort
         if (has_emitters_) {
             timers_.start(kEmit);
-            const long released =
+            released =
                 emitters_.step(store_, ranges_.solid_end, time_ + dt, params_.gravity, fluid_.rest_density, temperature_);
             counts_.by_type[kFluid] += released;
             counts_.by_type[kPending] -= released;
-            emitted_since_sort_ += released;
             timers_.stop(kEmit);
         }
 
@@ -237,7 +234,7 @@ class BackendSimulation final : public Simulation {
         if (motion.first_bad != 0xffffffffu) report_non_finite(motion.first_bad);
         if (solid_motion.first_bad != 0xffffffffu)
             report_non_finite(solids_.store_index_of_slot(solid_motion.first_bad), "solid inner particle (IBP)");
-        fill_report(dt, iterations, error, fluid_count, motion);
+        fill_report(dt, iterations, error, fluid_count, motion, released);
         report_.retries = retries;
         report_.heat_substeps = has_heat_ ? heat_.last_substeps() : 0;
         report_.heat_content = has_heat_ ? heat_.last_content() : 0.0;
@@ -360,8 +357,9 @@ class BackendSimulation final : public Simulation {
         "neighbors", "solid_volumes", "viscosity", "interface_tension", "pcisph", "heat",
         "coupling",  "lsm",           "integrate", "solid_contact",     "melting", "emit"};
 
+    // `released`: this step's emitted particles, fluid now but sorted as inactive until the next step.
     void fill_report(Real dt, int iterations, const DensityError& error, std::size_t fluid_count,
-                     const MotionSummary& motion) {
+                     const MotionSummary& motion, long released) {
         double stage_ms[kStageCount];
         timers_.read(stage_ms);
         report_.step = step_;
@@ -372,7 +370,9 @@ class BackendSimulation final : public Simulation {
         report_.density_error_max = error.max;
         report_.max_speed = std::sqrt(double(motion.max_speed2));
         report_.kinetic_energy = motion.kinetic_energy;
-        report_.lost_particles = static_cast<long>(store_.moving_count() - ranges_.solid_end) - inactive_by_design_;
+        // The inactive group holds, besides lost fluid, the GPs and pending particles by design.
+        const long inactive_by_design = counts_.by_type[kGeometry] + counts_.by_type[kPending] + released;
+        report_.lost_particles = static_cast<long>(store_.moving_count() - ranges_.solid_end) - inactive_by_design;
         report_.stage_ms.clear();
         report_.total_ms = 0;
         for (int stage : active_stages_) {
@@ -458,9 +458,7 @@ class BackendSimulation final : public Simulation {
     PhaseChange melting_;
     bool has_emitters_ = false;  // fluid emitters (emitter.hpp)
     FluidEmitters emitters_;
-    long emitted_since_sort_ = 0;  // released at the end of the last step: still in the inactive range
     ParticleCounts counts_;
-    long inactive_by_design_ = 0;  // GPs and pending particles: sorted with the inactive group but not lost
     double time_ = 0;
     long step_ = 0;
     double last_max_speed_ = 0;
@@ -497,7 +495,6 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup) : par
             throw InputError("simulation setup: unknown particle type " + std::to_string(type[k]));
         if (type[k] != kStaticBoundary) ++moving;
         ++counts_.by_type[type[k]];
-        if (type[k] == kGeometry || type[k] == kPending) ++inactive_by_design_;
         if (!is_finite(position[k]) || !is_finite(velocity[k]))
             throw InputError("simulation setup: particle " + std::to_string(i) +
                              " has a non-finite position or velocity");
@@ -767,8 +764,6 @@ void BackendSimulation<Kernel>::load_state(const StateArchive& in) {
         if (t >= kParticleTypeCount) throw InputError("checkpoint: unknown particle type " + std::to_string(t));
         ++counts_.by_type[t];
     }
-    inactive_by_design_ = counts_.by_type[kGeometry] + counts_.by_type[kPending];
-    emitted_since_sort_ = 0;
     if (counts_.by_type[kPending] != emitters_.capacity() - emitters_.released_total())
         throw InputError("checkpoint: its pending particles do not match its emitters' released layers");
     report_ = StepReport{};

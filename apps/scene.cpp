@@ -619,14 +619,14 @@ void read_emitters(Section& root, Scene& scene) {
                                           format_number(e.end));
         e.temperature = Real(s.number("temperature", double(scene.fluid_temperature), kTemperatureRange));
         // The disc's particles start r0/2 inside the domain at the most, as a fluid block's do.
-        const Real margin = scene.params.fluid.spacing / 2, reach = e.radius;
+        const double margin = 0.5 * double(scene.params.fluid.spacing) * (1 - 1e-6);
         const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
+        const double n[3] = {e.direction.x, e.direction.y, e.direction.z}, c[3] = {e.center.x, e.center.y, e.center.z},
+                     low[3] = {lo.x, lo.y, lo.z}, high[3] = {hi.x, hi.y, hi.z};
         for (int a = 0; a < 3; ++a) {
             // How far the disc reaches along axis a: radius × sin(angle between the axis and its normal).
-            const Real d = (&e.direction.x)[a];
-            const Real extent = reach * std::sqrt(std::max(Real(0), Real(1) - d * d));
-            const Real c = (&e.center.x)[a];
-            if (c - extent < (&lo.x)[a] + margin - Real(1e-6) * margin || c + extent > (&hi.x)[a] - margin + Real(1e-6) * margin)
+            const double extent = radius * std::sqrt(std::max(0.0, 1 - n[a] * n[a]));
+            if (c[a] - extent < low[a] + margin || c[a] + extent > high[a] - margin)
                 s.fail(s.path(), "the disc (center " + describe_point(e.center) + ", radius " + format_number(radius) +
                                      ") must lie inside the domain " + describe_box(lo, hi) + ", r0/2 from its faces");
         }
