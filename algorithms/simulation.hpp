@@ -201,6 +201,15 @@ struct HostParticles {
     std::vector<Real> temperature;  // empty without heat conduction
 };
 
+// A box of grid nodes for the fluid's colour field (surface_field.hpp): node (i, j, k) at
+// origin + spacing (i, j, k), i fastest.
+struct SurfaceNodes {
+    Vec3 origin{0, 0, 0};
+    Real spacing = 1;
+    int dims[3] = {0, 0, 0};
+    std::size_t count() const { return std::size_t(dims[0]) * std::size_t(dims[1]) * std::size_t(dims[2]); }
+};
+
 struct StepReport {
     long step = 0;
     double time = 0;           // simulated time after the step, s
@@ -243,6 +252,12 @@ class Simulation {
     // is absent: it costs no launch and no memory).
     virtual std::vector<std::string> stage_names() const = 0;
     virtual void download(HostParticles& out) const = 0;
+    // The fluid's colour field at `nodes` (surface_field.hpp), copied to the host, for surface
+    // reconstruction at frame times. Rebuilds the neighbour grid from the current positions; the
+    // next step's build then finds the store already in order, so a run with surfaces takes the
+    // same steps, bitwise, as one without. The colour field's iso-value for the surface comes with
+    // it (surface_iso_value).
+    virtual void fluid_color_field(const SurfaceNodes& nodes, std::vector<float>& color, double& iso) = 0;
     virtual ParticleCounts counts() const = 0;
     virtual std::size_t device_bytes() const = 0;
     virtual double time() const = 0;

@@ -25,6 +25,7 @@
 #include "algorithms/solid_bodies.hpp"
 #include "algorithms/state_archive.hpp"
 #include "algorithms/step_size.hpp"
+#include "algorithms/surface_field.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -259,6 +260,7 @@ class BackendSimulation final : public Simulation {
         return names;
     }
     void download(HostParticles& out) const override;
+    void fluid_color_field(const SurfaceNodes& nodes, std::vector<float>& color, double& iso) override;
     ParticleCounts counts() const override { return counts_; }
     // Everything this simulation holds on the device, and the backend's shared scratch (the
     // sort's buffers, sized by the largest sort of the process so far).
@@ -267,7 +269,7 @@ class BackendSimulation final : public Simulation {
                pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() + solids_.bytes() +
                contact_boxes_.bytes() + contact_objects_.bytes() + contact_object_distances_.bytes() +
                impulse_per_weight_.bytes() + fluid_near_solid_.bytes() + heat_.bytes() + melting_.bytes() +
-               emitters_.bytes() + backend_scratch_bytes();
+               emitters_.bytes() + color_field_.bytes() + backend_scratch_bytes();
     }
     double time() const override { return time_; }
     int heat_substeps_needed(double dt) const override { return has_heat_ ? heat_.substeps_needed(dt) : 0; }
@@ -464,6 +466,11 @@ class BackendSimulation final : public Simulation {
     double last_max_speed_ = 0;
     StepSizeControl step_size_;  // CFL mode: the bound, and the limit PCISPH retries set
     StepReport report_;
+    // Surface reconstruction at frame times (surface_field.hpp): the colour field's nodes, sized
+    // by the first frame that asks, and its iso-value and normalisation, computed then.
+    DeviceArray<Real> color_field_;
+    double surface_iso_ = -1;
+    Real surface_inverse_lattice_sum_ = 1;
 };
 
 template <class Kernel>
@@ -714,6 +721,25 @@ void BackendSimulation<Kernel>::download(HostParticles& out) const {
         out.object[i] = object[k];
         if (temperature_) out.temperature[i] = temperature[k];
     }
+}
+
+template <class Kernel>
+void BackendSimulation<Kernel>::fluid_color_field(const SurfaceNodes& nodes, std::vector<float>& color, double& iso) {
+    // The particles have moved since this step's build; a build now (a stable sort by the keys the
+    // next step would compute) leaves the next step's build nothing to reorder.
+    ranges_ = grid_.build(store_);
+    if (solids_.active()) solids_.update_slot_map(store_);
+    if (surface_iso_ < 0) {
+        surface_iso_ = surface_iso_value(fluid_.kernel, double(params_.fluid.spacing));
+        surface_inverse_lattice_sum_ =
+            Real(1.0 / prototype_sums(fluid_.kernel, double(params_.fluid.spacing), 3).sum_W);
+    }
+    iso = surface_iso_;
+    color_field_.resize(nodes.count());
+    compute_color_field(grid_.view(), store_.position.cview(), fluid_.kernel, surface_inverse_lattice_sum_, nodes,
+                        color_field_.view());
+    const std::vector<Real> values = color_field_.to_host();
+    color.assign(values.begin(), values.end());
 }
 
 // What the next step reads that the setup does not give: the store's persistent fields (in their

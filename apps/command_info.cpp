@@ -45,7 +45,7 @@ int command_info(int argc, char** argv) {
     const Real wall_gap = scene.walls ? scene.wall_gap() : Real(0);
     const std::string heat_warning =
         heat_substeps_warning(probe->heat_substeps_needed(double(solver.dt)), scene.params.heat.max_substeps);
-    const long frames = scene.writes_vtu() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
+    const long frames = scene.writes_frames() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
 
     if (flag_option(args, "json")) {
         SceneJson j;
@@ -118,6 +118,10 @@ int command_info(int argc, char** argv) {
                     double(solver.dt), static_cast<long>(std::ceil(scene.end_time / solver.dt - 1e-9)), scene.end_time,
                     stopping_rule, solver.min_iterations, solver.max_iterations);
     std::printf("run         to t=%g s; %ld frames (%g per simulated second)\n", scene.end_time, frames, scene.fps);
+    if (scene.writes_surface())
+        std::printf("surface     the fluid's surface with every frame (frames/surface_NNNNN.obj): its colour field on "
+                    "nodes %g r0 apart, meshed%s\n",
+                    scene.surface_voxel, scene.writes_vtu() ? "" : " (no particle frames: output.formats has no \"vtu\")");
     if (scene.walls)
         std::printf("boundary    domain walls, %d layer(s) at %g m, the first %.3g r0 outside the faces (where fluid "
                     "next to a face starts at rest density for h %.3g r0); %zu static box(es)\n",

@@ -183,7 +183,7 @@ int command_run(int argc, char** argv) {
             if (std::filesystem::is_directory(path))
                 throw InputError(path + " is a directory; the run writes a file there");
         const std::string frames_path = out_dir + "/frames";
-        if (scene.writes_vtu() && std::filesystem::exists(frames_path) && !std::filesystem::is_directory(frames_path))
+        if (scene.writes_frames() && std::filesystem::exists(frames_path) && !std::filesystem::is_directory(frames_path))
             throw InputError(frames_path + " is a file; the run writes its frames in a directory there");
         sim = create_simulation(setup, backend, threads);
         if (resume) sim->load_state(resume->state);
@@ -205,8 +205,8 @@ int command_run(int argc, char** argv) {
     std::vector<double> frame_times;  // of every frame up to now, for the next checkpoint
     if (resume) frame_times = resume->frame_times;
     std::unique_ptr<FrameWriter> frames;
-    if (scene.writes_vtu()) {
-        frames = std::make_unique<FrameWriter>(out_dir);
+    if (scene.writes_frames()) {
+        frames = std::make_unique<FrameWriter>(out_dir, scene.writes_vtu());
         frames->set_objects(setup.solids);
         if (continues_directory) frames->keep_earlier(frame_times);
     }
@@ -260,10 +260,30 @@ int command_run(int argc, char** argv) {
     double stats_write_seconds = 0;  // how long the last rewrite of stats.csv took
     HostParticles host;
     int frame_index = first_frame;
+    std::vector<double> surface_ms, surface_field_ms;  // per mesh: all of it, and the colour field's part
+    std::vector<float> color_field;  // kept: the next frame's field reuses it
     auto write_frame = [&]() {
         if (!frames) return;
         sim->download(host);
         frames->write(frame_index, host, sim->time());
+        if (scene.writes_surface()) {
+            const auto start = std::chrono::steady_clock::now();
+            const Real spacing = Real(scene.surface_voxel) * scene.params.fluid.spacing;
+            const SurfaceNodes nodes =
+                surface_nodes_around_fluid(host, scene.params.domain_min, scene.params.domain_max,
+                                           scene.params.fluid.support_radius, spacing, kMaxSurfaceNodes);
+            double iso = 0;
+            if (nodes.count() > 0) sim->fluid_color_field(nodes, color_field, iso);
+            const auto field_done = std::chrono::steady_clock::now();
+            const SurfaceMesh mesh = mesh_color_field(nodes, color_field, iso, threads);
+            surface_ms.push_back(1000.0 * seconds_since(start));
+            surface_field_ms.push_back(1000.0 * std::chrono::duration<double>(field_done - start).count());
+            frames->write_surface(frame_index, mesh);
+            summary.surfaces = static_cast<int>(surface_ms.size());
+            summary.surface_ms_median = median_of(surface_ms);
+            summary.surface_field_ms_median = median_of(surface_field_ms);
+            summary.surface_triangles_last = static_cast<long>(mesh.triangles.size());
+        }
         frame_times.push_back(sim->time());
         ++frame_index;
     };
@@ -421,8 +441,12 @@ int command_run(int argc, char** argv) {
     std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",
                 interrupted ? "interrupted after" : "ran", summary.steps, summary.simulated_time, summary.wall_seconds,
                 stats.median_total_ms(), fluid_figures);
-    std::printf("meltwater: results in %s (%s in frames/, stats.csv, summary.json%s)\n",
-                ec ? out_dir.c_str() : shown.c_str(), count_of(summary.frames, "frame").c_str(),
+    const std::string surfaces =
+        summary.surfaces > 0 ? " and " + count_of(summary.surfaces, "surface") + " (" +
+                                   format_number(summary.surface_ms_median) + " ms each)"
+                             : "";
+    std::printf("meltwater: results in %s (%s%s in frames/, stats.csv, summary.json%s)\n",
+                ec ? out_dir.c_str() : shown.c_str(), count_of(summary.frames, "frame").c_str(), surfaces.c_str(),
                 summary.checkpoint.empty() ? "" : ", checkpoint.mwc");
     if (!summary.checkpoint.empty() && !quiet)
         std::fprintf(stderr, "meltwater: checkpoint at step %ld (t = %.6g s); continue with: meltwater run --resume %s "

@@ -14,13 +14,14 @@
 
 namespace mw {
 
-namespace {
-double median(std::vector<double> v) {
+double median_of(std::vector<double> v) {
     if (v.empty()) return 0;
     std::sort(v.begin(), v.end());
     const std::size_t n = v.size();
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
+
+namespace {
 std::vector<float> to_floats(const std::vector<Real>& v) { return std::vector<float>(v.begin(), v.end()); }
 
 // JSON numbers must be finite; a NaN would make nlohmann write `null` anyway, say so explicitly.
@@ -54,7 +55,8 @@ void remove_earlier_frames(const std::string& out_dir, int keep_below) {
             const std::string frame_name = tmp == std::string::npos ? name : name.substr(0, tmp);
             const std::string extension = std::filesystem::path(frame_name).extension().string();
             const bool frame = (frame_name.rfind("particles_", 0) == 0 && extension == ".vtu") ||
-                               (frame_name.rfind("object_", 0) == 0 && extension == ".obj");
+                               ((frame_name.rfind("object_", 0) == 0 || frame_name.rfind("surface_", 0) == 0) &&
+                                extension == ".obj");
             const int number = frame ? frame_number(frame_name, extension) : -1;
             const bool kept = tmp == std::string::npos && number >= 0 && number < keep_below;
             if ((frame && !kept) || frame_name == "particles.pvd") std::filesystem::remove(entry.path(), error);
@@ -70,7 +72,8 @@ void remove_earlier_frames(const std::string& out_dir, int keep_below) {
     }
 }
 
-FrameWriter::FrameWriter(const std::string& out_dir) : frames_dir_(out_dir + "/frames") {
+FrameWriter::FrameWriter(const std::string& out_dir, bool particles)
+    : frames_dir_(out_dir + "/frames"), particles_(particles) {
     make_directories(frames_dir_);
 }
 
@@ -81,6 +84,11 @@ std::string FrameWriter::particles_name(int index) {
 }
 
 std::string FrameWriter::write(int index, const HostParticles& p, double time) {
+    if (!particles_) {  // surfaces only: the objects' meshes go with them
+        write_objects(index, p);
+        ++written_;
+        return "";
+    }
     const std::string name = particles_name(index);
     const std::string path = frames_dir_ + "/" + name;
     // An emitter's particles not released yet are not in the scene: left out, so a frame holds
@@ -133,6 +141,24 @@ void FrameWriter::write_collection() const {
             out << line;
         }
         out << "  </Collection>\n</VTKFile>\n";
+    });
+}
+
+void FrameWriter::write_surface(int index, const SurfaceMesh& mesh) const {
+    char name[64];
+    std::snprintf(name, sizeof name, "/surface_%05d.obj", index);
+    write_file_atomically(frames_dir_ + name, [&](std::ostream& out) {
+        out << "# meltwater fluid surface, frame " << index << ": " << mesh.vertices.size() << " vertices, "
+            << mesh.triangles.size() << " triangles\n";
+        char line[128];
+        for (const Vec3& x : mesh.vertices) {
+            std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", double(x.x), double(x.y), double(x.z));
+            out << line;
+        }
+        for (const auto& t : mesh.triangles) {
+            std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+            out << line;
+        }
     });
 }
 
@@ -236,11 +262,11 @@ std::string stats_rows_up_to(const std::string& path, const std::string& header,
 
 std::vector<double> StatsTable::median_stage_ms() const {
     std::vector<double> out;
-    for (const auto& column : stage_ms_) out.push_back(median(column));
+    for (const auto& column : stage_ms_) out.push_back(median_of(column));
     return out;
 }
 
-double StatsTable::median_total_ms() const { return median(total_ms_); }
+double StatsTable::median_total_ms() const { return median_of(total_ms_); }
 
 double StatsTable::density_error_avg() const {
     if (error_avg_.empty()) return 0;
@@ -298,6 +324,11 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     for (std::size_t s = 0; s < medians.size(); ++s) ms[stats.stage_names()[s]] = medians[s];
     ms["total"] = stats.median_total_ms();
     j["ms_per_step"] = ms;
+    if (scene.writes_surface())
+        j["surface"] = {{"meshes", run.surfaces},
+                        {"ms_per_mesh", run.surface_ms_median},
+                        {"field_ms_per_mesh", run.surface_field_ms_median},
+                        {"triangles_last", run.surface_triangles_last}};
     const double step_seconds = stats.sum_total_ms() / 1000.0;
     j["particle_steps_per_second"] =
         step_seconds > 0 ? double(run.particles.total()) * double(stats.rows()) / step_seconds : 0.0;

@@ -1,6 +1,7 @@
 // What `meltwater run` writes into its output directory, each file atomically:
 //   frames/particles_NNNNN.vtu   the particles (velocity, density, pressure, type, object)
 //   frames/object_NAME_NNNNN.obj the deformed mesh (GP positions) of each solid object, same NNNNN
+//   frames/surface_NNNNN.obj     the fluid's surface (surface/fluid_surface.hpp), same NNNNN
 //   stats.csv                    one row per step
 //   summary.json                 the run in one object, the resolved scene included
 #pragma once
@@ -10,11 +11,12 @@
 
 #include "algorithms/simulation.hpp"
 #include "apps/scene.hpp"
+#include "surface/fluid_surface.hpp"
 
 namespace mw {
 
 // Frames of an earlier run into the same directory would mix with this run's, or sit next to a
-// summary that says it wrote none: remove them (particles_*.vtu, particles.pvd, object_*.obj,
+// summary that says it wrote none: remove them (particles_*.vtu, particles.pvd, object_*.obj, surface_*.obj,
 // and the temporaries of a killed run), and frames/ itself when that leaves it empty. Run before
 // every run, with or without frames. A run resumed in its checkpoint's directory keeps the
 // frames numbered below `keep_below` (those written before the checkpoint).
@@ -25,10 +27,12 @@ void remove_earlier_frames(const std::string& out_dir, int keep_below = 0);
 // checkpoint's directory continues the table from there.
 std::string stats_rows_up_to(const std::string& path, const std::string& header, long last_step);
 
-// Writes frames/particles_NNNNN.vtu (and the objects' meshes, once set_objects() was called).
+// Writes frames/particles_NNNNN.vtu (and the objects' meshes, once set_objects() was called),
+// and the fluid's surface meshes (write_surface).
 class FrameWriter {
    public:
-    explicit FrameWriter(const std::string& out_dir);  // creates frames/
+    // Creates frames/. `particles`: write the particle frames (output.formats "vtu").
+    explicit FrameWriter(const std::string& out_dir, bool particles = true);
     // The solid objects whose meshes go with every frame (static ones: their rest mesh).
     // A melting object has no mesh to write (its lattice is all of it): its particles show it.
     void set_objects(const std::vector<SolidSetup>& solids) {
@@ -39,6 +43,8 @@ class FrameWriter {
     // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView
     // collection listing every frame with its time. Returns the frame's path.
     std::string write(int index, const HostParticles& particles, double time);
+    // frames/surface_NNNNN.obj: the fluid's surface at frame `index`.
+    void write_surface(int index, const SurfaceMesh& mesh) const;
     // A resumed run in its checkpoint's directory: frames 0 .. frame_times.size() - 1 (those of
     // them still there), which particles.pvd keeps listing before the new ones; rewrites it at once.
     void keep_earlier(const std::vector<double>& frame_times);
@@ -50,6 +56,7 @@ class FrameWriter {
     void write_objects(int index, const HostParticles& particles) const;
     void write_collection() const;
     std::string frames_dir_;
+    bool particles_ = true;
     std::vector<SolidSetup> objects_;
     int written_ = 0;
     std::vector<std::pair<double, std::string>> collection_;
@@ -122,6 +129,12 @@ struct RunSummary {
     long fluid_carved = 0;  // fluid particles left out where static boxes and objects stand
     std::size_t device_bytes = 0;
     int frames = 0;
+    // Surface reconstruction (output.formats "surface"): meshes written, the median time one took
+    // (colour field, copy and meshing; writing the file aside), and the last one's triangles.
+    int surfaces = 0;
+    double surface_ms_median = 0;
+    double surface_field_ms_median = 0;  // of which the colour field (grid build, field, host copy)
+    long surface_triangles_last = 0;
     std::string stop_condition;  // "steps N" or "time T s"
     std::vector<std::string> warnings;  // about the scene, given before the run (Scene::kernel_warning)
     // A resumed run: the checkpoint it started from, and that checkpoint's step and time.
@@ -132,6 +145,8 @@ struct RunSummary {
     std::string checkpoint;
     long checkpoint_step = 0;
 };
+
+double median_of(std::vector<double> values);  // 0 for none
 
 void write_summary(const std::string& path, const RunSummary& summary, const StatsTable& stats, const Scene& scene);
 

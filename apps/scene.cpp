@@ -1,4 +1,5 @@
 #include "apps/scene.hpp"
+#include "surface/fluid_surface.hpp"
 
 #include <algorithm>
 #include <array>
@@ -636,7 +637,10 @@ void read_emitters(Section& root, Scene& scene) {
 
 void read_output(Section s, Scene& scene) {
     scene.fps = s.number("fps", 30.0, Range{0, 10000, true, false});
-    scene.formats = s.string_list("formats", {"vtu"}, {"vtu"});
+    scene.formats = s.string_list("formats", {"vtu"}, {"vtu", "surface"});
+    Section surface = s.object("surface");
+    scene.surface_voxel = surface.number("voxel", 0.5, Range{0.1, 4, false, false});
+    surface.finish();
     s.finish();
 }
 
@@ -843,10 +847,9 @@ std::string heat_substeps_warning(int needed, int max_substeps) {
     return text;
 }
 
-bool Scene::writes_vtu() const {
-    for (const auto& f : formats)
-        if (f == "vtu") return true;
-    return false;
+bool Scene::writes_vtu() const { return std::find(formats.begin(), formats.end(), "vtu") != formats.end(); }
+bool Scene::writes_surface() const {
+    return std::find(formats.begin(), formats.end(), "surface") != formats.end();
 }
 
 const char* default_scene_text() { return kDefaultScene; }
@@ -888,6 +891,23 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     }
     read_output(root.object("output"), scene);
     root.finish();
+    if (scene.writes_surface()) {
+        // The surface's node box spans at most the domain and one support radius around it:
+        // refuse now a voxel that could need more nodes than a frame may take.
+        const SimulationParams& p = scene.params;
+        const double spacing = scene.surface_voxel * double(p.fluid.spacing), margin = 2.0 * double(p.fluid.support_radius) + spacing;
+        double nodes = 1;
+        for (double extent : {double(p.domain_max.x - p.domain_min.x), double(p.domain_max.y - p.domain_min.y),
+                              double(p.domain_max.z - p.domain_min.z)})
+            nodes *= std::ceil((extent + 2 * margin) / spacing) + 1;
+        if (nodes > double(kMaxSurfaceNodes)) {
+            char count[32];
+            std::snprintf(count, sizeof count, "%.3g", nodes);
+            throw InputError(source + ": output.surface.voxel " + format_number(scene.surface_voxel) +
+                             ": the surface over this domain could need " + count + " nodes, more than " +
+                             std::to_string(kMaxSurfaceNodes) + " (2^28); raise it");
+        }
+    }
     scene.resolved = out;
     return scene;
 }

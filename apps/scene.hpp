@@ -88,7 +88,8 @@ struct Scene {
     std::string base_dir;  // folder of the scene file ("" for text scenes): mesh paths are relative to it
     double end_time = 1.0;  // run.end_time, s
     double fps = 30;        // output.fps: frames per simulated second
-    std::vector<std::string> formats{"vtu"};
+    std::vector<std::string> formats{"vtu"};  // "vtu": particles; "surface": the fluid's surface mesh
+    double surface_voxel = 0.5;  // output.surface.voxel: the surface field's node spacing, in r0
     SceneJson resolved;  // every key with its value, defaults filled in, overrides applied
 
     Real boundary_spacing() const { return boundary_spacing_factor * params.fluid.spacing; }
@@ -97,6 +98,8 @@ struct Scene {
     // How far outside the domain faces the walls' first layer goes (sampling/wall_gap.hpp), m.
     Real wall_gap() const;
     bool writes_vtu() const;
+    bool writes_surface() const;
+    bool writes_frames() const { return !formats.empty(); }
     // A warning for a kernel the scene's support radius makes unstable ("" when there is none):
     // the cubic spline wider than 2.25 r0 (docs/solver.md, "Kernels").
     std::string kernel_warning() const;

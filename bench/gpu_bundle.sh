@@ -3,7 +3,7 @@
 # sm_90, the CUDA runtime linked statically) and packs what the GPU machine needs into ONE archive,
 # gpu-bundle/meltwater-gpu.tar.xz (gpu-bundle/ is git-ignored; name it in the run tool's `carry`).
 # The GPU machine has nvcc, CMake and ninja but none of this project's Debian packages (Eigen,
-# nanoflann, cxxopts, doctest, nlohmann-json, tinyobjloader, embree3, tbb) and cannot download them,
+# nanoflann, cxxopts, doctest, nlohmann-json, tinyobjloader, embree3, tbb, openvdb) and cannot download them,
 # so nothing is built there: bench/gpu_session.sh unpacks this archive into build-gpu/.
 #
 # The archive (unpacked into build-gpu/ at the repository root):

@@ -5,7 +5,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make ninja-build libeigen3-dev libnanoflann-dev libcxxopts-dev doctest-dev
-          nlohmann-json3-dev libtinyobjloader-dev libembree-dev libtbb-dev python3-meshio)
+          nlohmann-json3-dev libtinyobjloader-dev libembree-dev libtbb-dev python3-meshio
+          libopenvdb-dev libboost-dev libboost-iostreams-dev)
+# libboost-dev, libboost-iostreams-dev: OpenVDB's headers include Boost's and its CMake find module
+# asks for Boost.Iostreams, neither of which Debian 12's libopenvdb-dev pulls in.
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
