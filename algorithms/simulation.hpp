@@ -202,7 +202,8 @@ struct HostParticles {
 };
 
 // A box of grid nodes for the fluid's colour field (surface_field.hpp): node (i, j, k) at
-// origin + spacing (i, j, k), i fastest.
+// origin + spacing (i, j, k), i fastest. sampling/lattice.hpp's LatticeGrid is the same on the
+// host, in double and Eigen; this one is captured by device lambdas.
 struct SurfaceNodes {
     Vec3 origin{0, 0, 0};
     Real spacing = 1;
@@ -257,7 +258,7 @@ class Simulation {
     // next step's build then finds the store already in order, so a run with surfaces takes the
     // same steps, bitwise, as one without. The colour field's iso-value for the surface comes with
     // it (surface_iso_value).
-    virtual void fluid_color_field(const SurfaceNodes& nodes, std::vector<float>& color, double& iso) = 0;
+    virtual void fluid_color_field(const SurfaceNodes& nodes, std::vector<Real>& color, double& iso) = 0;
     virtual ParticleCounts counts() const = 0;
     virtual std::size_t device_bytes() const = 0;
     virtual double time() const = 0;

@@ -25,7 +25,7 @@ constexpr int kColorBlock = 4;
 // One work item per block of kColorBlock³ nodes: it visits the fluid particles of the cells
 // within h of the block once, and adds each particle within h of the block's box to all of the
 // block's nodes (W is 0 beyond h by itself). A fixed count of kernel evaluations per particle,
-// with no branch per node, the compiler unrolls; on the development VM this took a third of the
+// with no branch per node, the compiler unrolls; on the development VM this took a quarter of the
 // time of a gather per node over its 27 cells, and half that of visiting only the nodes within h
 // of each particle (their counts vary from row to row, and the branches mispredict once the
 // particles have left their lattice). The sums run in a fixed order (cells, then particles in

@@ -260,7 +260,7 @@ class BackendSimulation final : public Simulation {
         return names;
     }
     void download(HostParticles& out) const override;
-    void fluid_color_field(const SurfaceNodes& nodes, std::vector<float>& color, double& iso) override;
+    void fluid_color_field(const SurfaceNodes& nodes, std::vector<Real>& color, double& iso) override;
     ParticleCounts counts() const override { return counts_; }
     // Everything this simulation holds on the device, and the backend's shared scratch (the
     // sort's buffers, sized by the largest sort of the process so far).
@@ -466,11 +466,9 @@ class BackendSimulation final : public Simulation {
     double last_max_speed_ = 0;
     StepSizeControl step_size_;  // CFL mode: the bound, and the limit PCISPH retries set
     StepReport report_;
-    // Surface reconstruction at frame times (surface_field.hpp): the colour field's nodes, sized
-    // by the first frame that asks, and its iso-value and normalisation, computed then.
+    // Surface reconstruction at frame times (surface_field.hpp): the colour field at its nodes,
+    // sized by the largest node box asked for so far.
     DeviceArray<Real> color_field_;
-    double surface_iso_ = -1;
-    Real surface_inverse_lattice_sum_ = 1;
 };
 
 template <class Kernel>
@@ -724,22 +722,17 @@ void BackendSimulation<Kernel>::download(HostParticles& out) const {
 }
 
 template <class Kernel>
-void BackendSimulation<Kernel>::fluid_color_field(const SurfaceNodes& nodes, std::vector<float>& color, double& iso) {
+void BackendSimulation<Kernel>::fluid_color_field(const SurfaceNodes& nodes, std::vector<Real>& color, double& iso) {
     // The particles have moved since this step's build; a build now (a stable sort by the keys the
     // next step would compute) leaves the next step's build nothing to reorder.
     ranges_ = grid_.build(store_);
     if (solids_.active()) solids_.update_slot_map(store_);
-    if (surface_iso_ < 0) {
-        surface_iso_ = surface_iso_value(fluid_.kernel, double(params_.fluid.spacing));
-        surface_inverse_lattice_sum_ =
-            Real(1.0 / prototype_sums(fluid_.kernel, double(params_.fluid.spacing), 3).sum_W);
-    }
-    iso = surface_iso_;
     color_field_.resize(nodes.count());
-    compute_color_field(grid_.view(), store_.position.cview(), fluid_.kernel, surface_inverse_lattice_sum_, nodes,
+    // The mass is ρ0 over the lattice's Σ W (pcisph_delta.hpp): m / ρ0 normalises the field.
+    compute_color_field(grid_.view(), store_.position.cview(), fluid_.kernel, fluid_.mass / fluid_.rest_density, nodes,
                         color_field_.view());
-    const std::vector<Real> values = color_field_.to_host();
-    color.assign(values.begin(), values.end());
+    color_field_.download(color);
+    iso = surface_iso_value(fluid_.kernel, double(params_.fluid.spacing));  // a few thousand kernel values
 }
 
 // What the next step reads that the setup does not give: the store's persistent fields (in their

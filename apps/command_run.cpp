@@ -261,28 +261,20 @@ int command_run(int argc, char** argv) {
     HostParticles host;
     int frame_index = first_frame;
     std::vector<double> surface_ms, surface_field_ms;  // per mesh: all of it, and the colour field's part
-    std::vector<float> color_field;  // kept: the next frame's field reuses it
+    FluidSurfacer surfacer(scene.params, scene.surface_voxel, threads);
     auto write_frame = [&]() {
         if (!frames) return;
         sim->download(host);
         frames->write(frame_index, host, sim->time());
         if (scene.writes_surface()) {
-            const auto start = std::chrono::steady_clock::now();
-            const Real spacing = Real(scene.surface_voxel) * scene.params.fluid.spacing;
-            const SurfaceNodes nodes =
-                surface_nodes_around_fluid(host, scene.params.domain_min, scene.params.domain_max,
-                                           scene.params.fluid.support_radius, spacing, kMaxSurfaceNodes);
-            double iso = 0;
-            if (nodes.count() > 0) sim->fluid_color_field(nodes, color_field, iso);
-            const auto field_done = std::chrono::steady_clock::now();
-            const SurfaceMesh mesh = mesh_color_field(nodes, color_field, iso, threads);
-            surface_ms.push_back(1000.0 * seconds_since(start));
-            surface_field_ms.push_back(1000.0 * std::chrono::duration<double>(field_done - start).count());
-            frames->write_surface(frame_index, mesh);
+            const FluidSurfacer::Surface surface = surfacer.build(*sim, host);
+            frames->write_surface(frame_index, surface.mesh);
+            surface_ms.push_back(surface.ms);
+            surface_field_ms.push_back(surface.field_ms);
             summary.surfaces = static_cast<int>(surface_ms.size());
             summary.surface_ms_median = median_of(surface_ms);
             summary.surface_field_ms_median = median_of(surface_field_ms);
-            summary.surface_triangles_last = static_cast<long>(mesh.triangles.size());
+            summary.surface_triangles_last = static_cast<long>(surface.mesh.triangles.size());
         }
         frame_times.push_back(sim->time());
         ++frame_index;

@@ -1,6 +1,7 @@
 #include "apps/run_outputs.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -29,6 +30,26 @@ SceneJson finite_or_null(double v) { return std::isfinite(v) ? SceneJson(v) : Sc
 }  // namespace
 
 namespace {
+// An OBJ file, atomically: a comment line, vertex_at(0 .. vertex_count - 1) (x, y, z), and the
+// triangles (0-based here, 1-based in the file).
+template <class VertexAt>
+void write_obj(const std::string& path, const std::string& comment, std::size_t vertex_count, VertexAt vertex_at,
+               const std::vector<std::array<int, 3>>& triangles) {
+    write_file_atomically(path, [&](std::ostream& out) {
+        out << "# " << comment << "\n";
+        char line[128];
+        for (std::size_t v = 0; v < vertex_count; ++v) {
+            const std::array<double, 3> x = vertex_at(v);
+            std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", x[0], x[1], x[2]);
+            out << line;
+        }
+        for (const auto& t : triangles) {
+            std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+            out << line;
+        }
+    });
+}
+
 // The NNNNN of a frame's file name (particles_NNNNN.vtu, object_NAME_NNNNN.obj), or -1.
 int frame_number(const std::string& name, const std::string& extension) {
     const std::size_t digits = 5;
@@ -144,44 +165,31 @@ void FrameWriter::write_collection() const {
     });
 }
 
-void FrameWriter::write_surface(int index, const SurfaceMesh& mesh) const {
+void FrameWriter::write_surface(int index, const TriangleMesh& mesh) const {
     char name[64];
     std::snprintf(name, sizeof name, "/surface_%05d.obj", index);
-    write_file_atomically(frames_dir_ + name, [&](std::ostream& out) {
-        out << "# meltwater fluid surface, frame " << index << ": " << mesh.vertices.size() << " vertices, "
-            << mesh.triangles.size() << " triangles\n";
-        char line[128];
-        for (const Vec3& x : mesh.vertices) {
-            std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", double(x.x), double(x.y), double(x.z));
-            out << line;
-        }
-        for (const auto& t : mesh.triangles) {
-            std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
-            out << line;
-        }
-    });
+    const std::string header = "meltwater fluid surface, frame " + std::to_string(index) + ": " +
+                               std::to_string(mesh.vertices.size()) + " vertices, " +
+                               std::to_string(mesh.triangles.size()) + " triangles";
+    write_obj(frames_dir_ + name, header, mesh.vertices.size(), [&](std::size_t v) {
+        const Vec3d& x = mesh.vertices[v];
+        return std::array<double, 3>{x.x(), x.y(), x.z()};
+    },
+              mesh.triangles);
 }
 
 void FrameWriter::write_objects(int index, const HostParticles& p) const {
     for (const SolidSetup& o : objects_) {
         char name[64];
         std::snprintf(name, sizeof name, "_%05d.obj", index);
-        const std::string path = frames_dir_ + "/object_" + o.name + name;
-        write_file_atomically(path, [&](std::ostream& out) {
-            out << "# meltwater object " << o.name << ", frame " << index << "\n";
-            char line[128];
-            const bool moving = o.kind != SolidKind::kStatic;
-            const std::size_t n = moving ? o.gp.size() : o.rest_vertices.size();
-            for (std::size_t g = 0; g < n; ++g) {
-                const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
-                std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", double(x.x), double(x.y), double(x.z));
-                out << line;
-            }
-            for (const auto& t : o.triangles) {
-                std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
-                out << line;
-            }
-        });
+        const bool moving = o.kind != SolidKind::kStatic;
+        write_obj(frames_dir_ + "/object_" + o.name + name, "meltwater object " + o.name + ", frame " + std::to_string(index),
+                  moving ? o.gp.size() : o.rest_vertices.size(),
+                  [&](std::size_t g) {
+                      const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
+                      return std::array<double, 3>{double(x.x), double(x.y), double(x.z)};
+                  },
+                  o.triangles);
     }
 }
 

@@ -44,7 +44,7 @@ class FrameWriter {
     // collection listing every frame with its time. Returns the frame's path.
     std::string write(int index, const HostParticles& particles, double time);
     // frames/surface_NNNNN.obj: the fluid's surface at frame `index`.
-    void write_surface(int index, const SurfaceMesh& mesh) const;
+    void write_surface(int index, const TriangleMesh& mesh) const;
     // A resumed run in its checkpoint's directory: frames 0 .. frame_times.size() - 1 (those of
     // them still there), which particles.pvd keeps listing before the new ones; rewrites it at once.
     void keep_earlier(const std::vector<double>& frame_times);

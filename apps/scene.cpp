@@ -894,12 +894,8 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     if (scene.writes_surface()) {
         // The surface's node box spans at most the domain and one support radius around it:
         // refuse now a voxel that could need more nodes than a frame may take.
-        const SimulationParams& p = scene.params;
-        const double spacing = scene.surface_voxel * double(p.fluid.spacing), margin = 2.0 * double(p.fluid.support_radius) + spacing;
-        double nodes = 1;
-        for (double extent : {double(p.domain_max.x - p.domain_min.x), double(p.domain_max.y - p.domain_min.y),
-                              double(p.domain_max.z - p.domain_min.z)})
-            nodes *= std::ceil((extent + 2 * margin) / spacing) + 1;
+        const double nodes =
+            most_surface_nodes(scene.params, Real(scene.surface_voxel) * scene.params.fluid.spacing);
         if (nodes > double(kMaxSurfaceNodes)) {
             char count[32];
             std::snprintf(count, sizeof count, "%.3g", nodes);

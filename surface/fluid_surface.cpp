@@ -1,30 +1,54 @@
 #include "surface/fluid_surface.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <stdexcept>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/global_control.h>
 
-#include "backend/errors.hpp"
 
 namespace mw {
 
+namespace {
+// One support radius and one node beyond the outermost particles: the field is 0 there, so the
+// mesh closes inside the box. And a quarter node more: fluid on a lattice whose spacing the node
+// spacing divides (every scene's start) would otherwise have its faces, r0/2 outside the last
+// layer, exactly on a plane of nodes, where φ is 0 give or take rounding and the mesher cuts the
+// face into slivers (2.7 times the triangles on the default dam break's frame 0).
+Real node_margin(Real support_radius, Real spacing) { return support_radius + Real(1.25) * spacing; }
+}  // namespace
+
+std::array<double, 3> surface_node_dims(Vec3 lo, Vec3 hi, Real support_radius, Real spacing) {
+    const double margin = double(node_margin(support_radius, spacing));
+    const double extent[3] = {double(hi.x - lo.x), double(hi.y - lo.y), double(hi.z - lo.z)};
+    std::array<double, 3> dims{};
+    for (int a = 0; a < 3; ++a) dims[a] = std::ceil((extent[a] + 2 * margin) / double(spacing)) + 1;
+    return dims;
+}
+
+double most_surface_nodes(const SimulationParams& params, Real spacing) {
+    const Real h = params.fluid.support_radius;
+    const std::array<double, 3> dims = surface_node_dims(params.domain_min - Vec3{h, h, h},
+                                                         params.domain_max + Vec3{h, h, h}, h, spacing);
+    return dims[0] * dims[1] * dims[2];
+}
+
 SurfaceNodes surface_nodes_around_fluid(const HostParticles& particles, Vec3 domain_min, Vec3 domain_max,
-                                        Real support_radius, Real spacing, std::size_t max_nodes) {
+                                        Real support_radius, Real spacing) {
     SurfaceNodes nodes;
     nodes.spacing = spacing;
-    const Real inf = std::numeric_limits<Real>::infinity();
+    const Real inf = std::numeric_limits<Real>::infinity(), h = support_radius;
     Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
     bool any = false;
     for (std::size_t i = 0; i < particles.position.size(); ++i) {
         if (particles.type[i] != kFluid) continue;
         const Vec3 x = particles.position[i];
-        const Real h = support_radius;
         // Written so that a NaN position fails it too.
         if (!(x.x >= domain_min.x - h && x.x <= domain_max.x + h && x.y >= domain_min.y - h &&
               x.y <= domain_max.y + h && x.z >= domain_min.z - h && x.z <= domain_max.z + h))
@@ -34,33 +58,18 @@ SurfaceNodes surface_nodes_around_fluid(const HostParticles& particles, Vec3 dom
         any = true;
     }
     if (!any) return nodes;
-    // One support radius and one node beyond the outermost particles: the field is 0 there, so
-    // the mesh closes inside the box. And a quarter node more: fluid on a lattice whose spacing
-    // the node spacing divides (every scene's start) would otherwise have its faces, r0/2 outside
-    // the last layer, exactly on a plane of nodes, where φ is 0 give or take rounding and the
-    // mesher cuts the face into slivers (2.7 times the triangles on the default dam break's frame 0).
-    const Real margin = support_radius + Real(1.25) * spacing;
+    const std::array<double, 3> dims = surface_node_dims(lo, hi, support_radius, spacing);
+    if (dims[0] * dims[1] * dims[2] > double(kMaxSurfaceNodes))
+        throw std::logic_error("surface_nodes_around_fluid: more nodes than resolve_scene's check allows");
+    const Real margin = node_margin(support_radius, spacing);
     nodes.origin = Vec3{lo.x - margin, lo.y - margin, lo.z - margin};
-    const Real extent[3] = {hi.x - lo.x + 2 * margin, hi.y - lo.y + 2 * margin, hi.z - lo.z + 2 * margin};
-    double count = 1;
-    for (int a = 0; a < 3; ++a) {
-        const double d = std::ceil(double(extent[a]) / double(spacing)) + 1;
-        count *= d;
-        nodes.dims[a] = count <= double(max_nodes) ? static_cast<int>(d) : 0;
-    }
-    if (count > double(max_nodes)) {
-        char text[200];
-        std::snprintf(text, sizeof text,
-                      "surface: the fluid spans %.3g x %.3g x %.3g m, %.3g nodes at %.3g m, more than %zu; raise "
-                      "output.surface.voxel",
-                      double(hi.x - lo.x), double(hi.y - lo.y), double(hi.z - lo.z), count, double(spacing), max_nodes);
-        throw InputError(text);
-    }
+    for (int a = 0; a < 3; ++a) nodes.dims[a] = static_cast<int>(dims[a]);
     return nodes;
 }
 
-SurfaceMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<float>& color, double iso, int threads) {
-    SurfaceMesh mesh;
+TriangleMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<Real>& color, double iso, int threads) {
+    TriangleMesh mesh;
+    mesh.source = "the fluid's surface";
     if (nodes.count() == 0) return mesh;
     if (color.size() != nodes.count()) throw std::logic_error("mesh_color_field: field and nodes differ in size");
     static std::once_flag initialised;
@@ -73,7 +82,7 @@ SurfaceMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<float>
     // support radius (c = 0) are the background and stay inactive.
     std::vector<float> phi(color.size());
     const float iso_f = static_cast<float>(iso);
-    std::transform(color.begin(), color.end(), phi.begin(), [iso_f](float c) { return iso_f - c; });
+    std::transform(color.begin(), color.end(), phi.begin(), [iso_f](Real c) { return iso_f - float(c); });
     const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0),
                                  openvdb::Coord(nodes.dims[0] - 1, nodes.dims[1] - 1, nodes.dims[2] - 1));
     // LayoutXYZ: x varies fastest, as in the field.
@@ -91,7 +100,7 @@ SurfaceMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<float>
     std::vector<openvdb::Vec4I> quads;
     openvdb::tools::volumeToMesh(*grid, points, triangles, quads, 0.0, 0.0);
     mesh.vertices.reserve(points.size());
-    for (const auto& p : points) mesh.vertices.push_back(Vec3{Real(p.x()), Real(p.y()), Real(p.z())});
+    for (const auto& p : points) mesh.vertices.emplace_back(double(p.x()), double(p.y()), double(p.z()));
     // The mesher winds its polygons clockwise seen from the positive side of φ (outside): reversed
     // here, so that the triangles face out of the fluid.
     mesh.triangles.reserve(triangles.size() + 2 * quads.size());
@@ -103,16 +112,27 @@ SurfaceMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<float>
     return mesh;
 }
 
-double enclosed_volume(const SurfaceMesh& mesh) {
-    double volume = 0;
-    for (const auto& t : mesh.triangles) {
-        const Vec3 a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
-        volume += (double(a.x) * (double(b.y) * c.z - double(b.z) * c.y) +
-                   double(a.y) * (double(b.z) * c.x - double(b.x) * c.z) +
-                   double(a.z) * (double(b.x) * c.y - double(b.y) * c.x)) /
-                  6.0;
-    }
-    return volume;
+FluidSurfacer::FluidSurfacer(const SimulationParams& params, double voxel_in_r0, int threads)
+    : domain_min_(params.domain_min),
+      domain_max_(params.domain_max),
+      support_radius_(params.fluid.support_radius),
+      spacing_(Real(voxel_in_r0) * params.fluid.spacing),
+      threads_(threads) {}
+
+FluidSurfacer::Surface FluidSurfacer::build(Simulation& sim, const HostParticles& particles) {
+    using clock = std::chrono::steady_clock;
+    const auto ms_since = [](clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(clock::now() - t).count();
+    };
+    Surface out;
+    const auto start = clock::now();
+    const SurfaceNodes nodes = surface_nodes_around_fluid(particles, domain_min_, domain_max_, support_radius_, spacing_);
+    double iso = 0;
+    if (nodes.count() > 0) sim.fluid_color_field(nodes, color_, iso);
+    out.field_ms = ms_since(start);
+    out.mesh = mesh_color_field(nodes, color_, iso, threads_);
+    out.ms = ms_since(start);
+    return out;
 }
 
 }  // namespace mw

@@ -88,6 +88,24 @@ inline std::string out_dir(const std::string& name) {
 }
 inline nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path)); }
 
+// stats.csv without its timing columns (ms_*, which differ from run to run; the header names
+// them): what the physics computed, step by step.
+inline std::string stats_without_timings(const std::string& path) {
+    std::istringstream in(slurp(path));
+    std::string line, out;
+    std::vector<bool> keep;
+    while (std::getline(in, line)) {
+        std::istringstream cells(line);
+        std::string cell;
+        for (std::size_t c = 0; std::getline(cells, cell, ','); ++c) {
+            if (keep.size() <= c) keep.push_back(cell.rfind("ms_", 0) != 0);
+            if (keep[c]) out += cell + ",";
+        }
+        out += "\n";
+    }
+    return out;
+}
+
 // One line, naming each of `parts`, and exit status `code`.
 inline void check_rejected(const Result& r, const std::vector<std::string>& parts, int code = 2) {
     CAPTURE(r.err);

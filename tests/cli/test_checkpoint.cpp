@@ -21,19 +21,6 @@ std::string floating_boxes() {
            "/scenes/floating_boxes.json --set fluid.spacing=0.04 --set fluid.support_radius=0.08 "
            "--set output.fps=200 --threads 2 --quiet";
 }
-// stats.csv without its timing columns (ms_*, which differ from run to run): the first 12 of
-// each line, step to unconverged.
-std::string stats_without_timings(const std::string& path) {
-    std::istringstream text(slurp(path));
-    std::string line, kept;
-    while (std::getline(text, line)) {
-        std::size_t end = 0;
-        for (int column = 0; column < 12 && end != std::string::npos; ++column)
-            end = line.find(',', end == 0 ? 0 : end + 1);
-        kept += line.substr(0, end) + "\n";
-    }
-    return kept;
-}
 }  // namespace
 
 TEST_CASE("checkpoint: a run stopped half way and resumed ends byte for byte as the whole run") {

@@ -21,23 +21,6 @@ std::pair<long, long> obj_counts(const std::string& path) {
     while (std::getline(in, line)) vertices += line.rfind("v ", 0) == 0, faces += line.rfind("f ", 0) == 0;
     return {vertices, faces};
 }
-
-// stats.csv without its timing columns (ms_*): what the physics computed, step by step.
-std::string untimed_stats(const std::string& path) {
-    std::istringstream in(slurp(path));
-    std::string line, out;
-    std::vector<bool> keep;
-    while (std::getline(in, line)) {
-        std::istringstream cells(line);
-        std::string cell;
-        for (std::size_t c = 0; std::getline(cells, cell, ','); ++c) {
-            if (keep.size() <= c) keep.push_back(cell.rfind("ms_", 0) != 0);  // the header sets them
-            if (keep[c]) out += cell + ",";
-        }
-        out += "\n";
-    }
-    return out;
-}
 }  // namespace
 
 TEST_CASE("run: output.formats surface writes a closed mesh with every frame, and the same steps") {
@@ -70,7 +53,7 @@ TEST_CASE("run: output.formats surface writes a closed mesh with every frame, an
     CHECK(s["scene"]["output"]["surface"]["voxel"].get<double>() == doctest::Approx(0.5));
     CHECK(!read_json(without + "/summary.json").contains("surface"));
     // Meshing the surface reorders nothing the next step would not: the steps are the same.
-    CHECK(untimed_stats(with + "/stats.csv") == untimed_stats(without + "/stats.csv"));
+    CHECK(stats_without_timings(with + "/stats.csv") == stats_without_timings(without + "/stats.csv"));
 
     // Surfaces alone: no particle frames and no collection; a later run without them removes them.
     const std::string alone = out_dir("surface_alone");

@@ -6,7 +6,6 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <map>
 #include <utility>
 
 #include "surface/fluid_surface.hpp"
@@ -22,9 +21,9 @@ constexpr Real kR0 = Real(0.02);
 
 struct Surfaced {
     SurfaceNodes nodes;
-    std::vector<float> color;
+    std::vector<Real> color;
     double iso = 0;
-    SurfaceMesh mesh;
+    TriangleMesh mesh;
     std::size_t fluid = 0;
 };
 
@@ -35,25 +34,16 @@ Surfaced surface_of(Simulation& sim, const SimulationSetup& setup, double voxel_
     sim.download(host);
     for (std::uint8_t t : host.type) out.fluid += t == kFluid;
     out.nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max,
-                                           setup.params.fluid.support_radius, Real(voxel_in_r0) * kR0,
-                                           kMaxSurfaceNodes);
+                                           setup.params.fluid.support_radius, Real(voxel_in_r0) * kR0);
     sim.fluid_color_field(out.nodes, out.color, out.iso);
     out.mesh = mesh_color_field(out.nodes, out.color, out.iso, 0);
     return out;
 }
 
-// Every directed edge once and its reverse once: the mesh is closed, each edge between two
-// triangles, and its triangles wound consistently. Returns the edges that break it.
-long broken_edges(const SurfaceMesh& mesh) {
-    std::map<std::pair<int, int>, int> directed;
-    for (const auto& t : mesh.triangles)
-        for (int e = 0; e < 3; ++e) ++directed[{t[e], t[(e + 1) % 3]}];
-    long broken = 0;
-    for (const auto& [edge, count] : directed) {
-        const auto reverse = directed.find({edge.second, edge.first});
-        if (count != 1 || reverse == directed.end() || reverse->second != 1) ++broken;
-    }
-    return broken;
+// Closed (each edge between exactly two triangles) and wound consistently (sampling/mesh.hpp).
+bool closed_and_oriented(const TriangleMesh& mesh) {
+    const EdgeReport edges = edge_report(mesh);
+    return edges.closed() && edges.consistently_oriented();
 }
 
 SimulationSetup block_at_rest(Vec3 lo, Vec3 hi, Real support_in_r0 = 2, KernelKind kernel = KernelKind::kCubicSpline) {
@@ -131,8 +121,8 @@ TEST_CASE("surface: a lattice block's mesh is closed, faces outward, and holds N
         const Surfaced s = surface_of(*sim, setup, voxel);
         REQUIRE(s.fluid == 480);
         REQUIRE(!s.mesh.triangles.empty());
-        CHECK(broken_edges(s.mesh) == 0);
-        const double volume = enclosed_volume(s.mesh);
+        CHECK(closed_and_oriented(s.mesh));
+        const double volume = signed_volume(s.mesh);
         const double particles_volume = double(s.fluid) * kR0 * kR0 * kR0;
         CAPTURE(volume / particles_volume);
         MESSAGE("block, " << std::string(kernel_name(kernel)) << ", at voxel " << voxel << " r0: " << volume / particles_volume << " of N r0^3");
@@ -146,18 +136,10 @@ TEST_CASE("surface: a lattice block's mesh is closed, faces outward, and holds N
         CHECK(volume / particles_volume < 1.0);
         // Every face r0/2 outside the outermost layer of particles (at 0.11 .. 0.29 x 0.25 x 0.21 m):
         // on the block's own faces, within a tenth of r0.
-        Vec3 lo = s.mesh.vertices[0], hi = lo;
-        for (const Vec3& v : s.mesh.vertices) {
-            lo = Vec3{std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
-            hi = Vec3{std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
-        }
+        const Aabb box = bounding_box(s.mesh);
         const double half = 0.5 * kR0, tolerance = 0.1 * kR0;
-        CHECK(std::abs(lo.x - (0.11 - half)) < tolerance);
-        CHECK(std::abs(lo.y - (0.11 - half)) < tolerance);
-        CHECK(std::abs(lo.z - (0.11 - half)) < tolerance);
-        CHECK(std::abs(hi.x - (0.29 + half)) < tolerance);
-        CHECK(std::abs(hi.y - (0.25 + half)) < tolerance);
-        CHECK(std::abs(hi.z - (0.21 + half)) < tolerance);
+        CHECK((box.lo - Vec3d(0.11 - half, 0.11 - half, 0.11 - half)).cwiseAbs().maxCoeff() < tolerance);
+        CHECK((box.hi - Vec3d(0.29 + half, 0.25 + half, 0.21 + half)).cwiseAbs().maxCoeff() < tolerance);
         // About two triangles per voxel of the box's faces: no slivers where a face lies on a plane
         // of nodes (surface_nodes_around_fluid keeps them off it).
         const double area = 2 * (0.2 * 0.16 + 0.2 * 0.12 + 0.16 * 0.12), voxel_m = voxel * kR0;
@@ -185,9 +167,9 @@ TEST_CASE("surface: a lattice ball's mesh is round, at the radius of its particl
     const Surfaced s = surface_of(*sim, ball, 0.5);
     REQUIRE(s.fluid > 1500);
     MESSAGE("ball of " << s.fluid << " particles");
-    CHECK(broken_edges(s.mesh) == 0);
+    CHECK(closed_and_oriented(s.mesh));
     const double particles_volume = double(s.fluid) * kR0 * kR0 * kR0;
-    const double volume = enclosed_volume(s.mesh);
+    const double volume = signed_volume(s.mesh);
     CAPTURE(volume / particles_volume);
     CHECK(volume / particles_volume > 0.95);
     CHECK(volume / particles_volume < 1.03);
@@ -196,8 +178,8 @@ TEST_CASE("surface: a lattice ball's mesh is round, at the radius of its particl
     // +0.17 r0 with the nodes a quarter voxel over).
     const double expected = std::cbrt(3 * particles_volume / (4 * kPi));
     double nearest = 1e9, farthest = 0;
-    for (const Vec3& v : s.mesh.vertices) {
-        const double r = norm(v - centre);
+    for (const Vec3d& v : s.mesh.vertices) {
+        const double r = (v - Vec3d(centre.x, centre.y, centre.z)).norm();
         nearest = std::min(nearest, r), farthest = std::max(farthest, r);
     }
     CAPTURE(expected);
@@ -214,14 +196,30 @@ TEST_CASE("surface: no fluid in the domain, no nodes and an empty mesh") {
     host.type = setup.type;
     for (Vec3& x : host.position) x.z += 5;  // lost far above the domain
     const SurfaceNodes nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max,
-                                                          setup.params.fluid.support_radius, kR0, kMaxSurfaceNodes);
+                                                          setup.params.fluid.support_radius, kR0);
     CHECK(nodes.count() == 0);
     CHECK(mesh_color_field(nodes, {}, 0.3, 0).triangles.empty());
-    // A node box beyond the limit is an input error naming the key that sets the spacing.
-    host.position = setup.position;
-    CHECK_THROWS_WITH_AS(surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max,
-                                                    setup.params.fluid.support_radius, kR0, 100),
-                         doctest::Contains("output.surface.voxel"), InputError);
+}
+
+TEST_CASE("surface: the scene's bound on the nodes holds fluid anywhere the node box keeps it") {
+    // Fluid at two opposite corners, one support radius outside the domain (the farthest the node
+    // box keeps): the box spans all of it, and the scene's check (most_surface_nodes) bounds it.
+    const SimulationSetup setup = block_at_rest(Vec3{0.1f, 0.1f, 0.1f}, Vec3{0.14f, 0.14f, 0.14f});
+    const Real h = setup.params.fluid.support_radius;
+    HostParticles host;
+    host.position = {setup.params.domain_min - Vec3{h, h, h}, setup.params.domain_max + Vec3{h, h, h}};
+    host.type = {kFluid, kFluid};
+    for (Real spacing : {Real(0.25) * kR0, Real(0.5) * kR0, kR0}) {
+        CAPTURE(spacing);
+        const SurfaceNodes nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max, h, spacing);
+        REQUIRE(nodes.count() > 0);
+        CHECK(double(nodes.count()) <= most_surface_nodes(setup.params, spacing));
+        CHECK(double(nodes.count()) > 0.99 * most_surface_nodes(setup.params, spacing));
+    }
+    // Beyond one support radius: left out, as lost fluid.
+    host.position[1] = host.position[1] + Vec3{kR0, 0, 0};
+    const SurfaceNodes one = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max, h, kR0);
+    CHECK(one.count() < 1000);
 }
 
 TEST_CASE("surface: a run that meshes its surface every few steps takes the same steps, bitwise") {
