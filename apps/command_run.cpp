@@ -102,7 +102,7 @@ int command_run(int argc, char** argv) {
                              "frames/particles_NNNNN.vtu, stats.csv and summary.json into the output directory.");
     add_scene_options(options);
     options.add_options()
-        ("backend", "auto, cuda or openmp", cxxopts::value<std::string>()->default_value("auto"), "NAME")
+        ("backend", "auto (CUDA where a GPU is usable; with --resume, the checkpoint's backend where usable), cuda or openmp", cxxopts::value<std::string>()->default_value("auto"), "NAME")
         ("out", "output directory (default results/<scene name>)", cxxopts::value<std::string>(), "DIR")
         ("steps", "run exactly N steps", cxxopts::value<std::string>(), "N")
         ("time", "run to simulated time T seconds (default: the scene's run.end_time)", cxxopts::value<std::string>(), "T")
@@ -151,7 +151,13 @@ int command_run(int argc, char** argv) {
     if (resume && end_steps == 0 && !(resume->time < end_time * (1 - 1e-9)))
         throw InputError("the checkpoint is at t = " + format_number(resume->time) + " s, already at the end time " +
                          format_number(end_time) + " s; give a later --time, or --steps");
-    const std::string backend = choose_backend(args["backend"].as<std::string>());
+    // A resumed run left on auto continues on the backend that wrote the checkpoint, where that
+    // backend is available here: the backends round differently, and only the same backend
+    // continues bitwise (docs/cli.md, "Checkpoints").
+    const std::string requested_backend = args["backend"].as<std::string>();
+    const bool resume_on_saved = resume && requested_backend == "auto" &&
+                                 (resume->backend == "openmp" || (resume->backend == "cuda" && cuda_backend_info().available));
+    const std::string backend = choose_backend(resume_on_saved ? resume->backend : requested_backend);
     if (threads > 0 && backend != "openmp" && !quiet)
         std::fprintf(stderr, "meltwater: note: --threads applies to the openmp backend only\n");
     std::string checkpoint_dir;  // of the resumed checkpoint
