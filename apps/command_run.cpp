@@ -152,12 +152,13 @@ int command_run(int argc, char** argv) {
         throw InputError("the checkpoint is at t = " + format_number(resume->time) + " s, already at the end time " +
                          format_number(end_time) + " s; give a later --time, or --steps");
     // A resumed run left on auto continues on the backend that wrote the checkpoint, where that
-    // backend is available here: the backends round differently, and only the same backend
-    // continues bitwise (docs/cli.md, "Checkpoints").
+    // backend is usable here: the backends round differently, and only the same backend continues
+    // bitwise (docs/checkpoints.md). A checkpoint naming neither backend leaves auto as it is.
     const std::string requested_backend = args["backend"].as<std::string>();
-    const bool resume_on_saved = resume && requested_backend == "auto" &&
-                                 (resume->backend == "openmp" || (resume->backend == "cuda" && cuda_backend_info().available));
-    const std::string backend = choose_backend(resume_on_saved ? resume->backend : requested_backend);
+    const bool saved_backend_usable =
+        resume && (resume->backend == "openmp" || (resume->backend == "cuda" && cuda_backend_info().available));
+    const std::string backend =
+        choose_backend(requested_backend == "auto" && saved_backend_usable ? resume->backend : requested_backend);
     if (threads > 0 && backend != "openmp" && !quiet)
         std::fprintf(stderr, "meltwater: note: --threads applies to the openmp backend only\n");
     std::string checkpoint_dir;  // of the resumed checkpoint

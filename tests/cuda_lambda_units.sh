@@ -13,13 +13,16 @@
 # member is a unit). Exit 0 when no lambda is defined in two units, 1 (listing them) otherwise.
 set -euo pipefail
 [[ $# -gt 0 ]] || { echo "usage: $0 OBJECT_OR_ARCHIVE..." >&2; exit 2; }
-listing=$(for f in "$@"; do
+for f in "$@"; do
   [[ -r "$f" ]] || { echo "cuda_lambda_units: cannot read $f" >&2; exit 2; }
-  # nm -A prefixes each line with its unit: "lib.a:member.o:ADDRESS TYPE NAME" or "file.o:...".
-  nm -A "$f" | awk '$NF ~ /__nv_hdl_helper.*fp_copier/ { unit = $1; sub(/:[0-9a-f]+$/, "", unit); print unit "\t" $NF }'
-done)
+done
+# nm -A prefixes each line with its unit: "lib.a:member.o:ADDRESS TYPE NAME" or "file.o:...".
+listing=$(nm -A "$@" | awk '$NF ~ /__nv_hdl_helper.*fp_copier/ { unit = $1; sub(/:[0-9a-f]+$/, "", unit); print unit "\t" $NF }')
 units=$(cut -f1 <<<"$listing" | sort -u | grep -c . || true)
 lambdas=$(cut -f2 <<<"$listing" | sort -u | grep -c . || true)
+# None at all means the symbols are no longer named as this script expects (another nvcc): a check
+# that finds nothing to compare must not pass.
+((lambdas > 0)) || { echo "cuda_lambda_units: no __nv_hdl_helper<...>::fp_copier symbol in $*; has nvcc renamed them?"; exit 1; }
 shared=$(awk -F'\t' '{ seen[$2] = seen[$2] " " $1; count[$2]++ } END { for (k in count) if (count[k] > 1) print k "\t" seen[k] }' <<<"$listing")
 if [[ -n "$shared" ]]; then
   echo "cuda_lambda_units: $(grep -c . <<<"$shared") extended lambdas are defined in more than one CUDA unit:"

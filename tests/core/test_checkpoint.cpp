@@ -152,7 +152,8 @@ TEST_CASE("CUDA: a state saved on CUDA continues on OpenMP, and the other way ro
     // the lookahead and the corrections turn the backends' rounding into a 6e-5 m difference in
     // a single step, and the two backends' runs are 7.9e-3 m apart after 40 steps. One step from
     // OpenMP's state of step 20 differed by at most 1.1e-5 m (and by 1.3e-4 m from step 16's);
-    // a field lost in transfer moves fluid by its velocity times the step, about 3e-3 m.
+    // a field lost in transfer would move fluid by about its velocity times the step (an
+    // estimate: 1 m/s by 3.5 ms, 3.5e-3 m).
     const SimulationSetup setup = column_and_thrown_box();
     auto create = [&](bool cuda) { return cuda ? create_cuda_simulation(setup) : create_openmp_simulation(setup, 0); };
     for (const bool save_on_cuda : {true, false}) {

@@ -142,8 +142,8 @@ TEST_CASE("CUDA: a stream fills a tank as on OpenMP") {
         MW_SKIP("no CUDA device: the cross-backend emitter test needs one");
         return;
     }
-    // 60 steps (t = 0.19 s, 19 layers released): the stream is in flight and has not yet met the
-    // floor, which it does in step 64. Measured on an H200 (2026-12-04): the backends differ by
+    // 60 steps (t = 0.19 s): the stream is in flight and has not yet met the floor, which it
+    // does in step 64. Measured on an H200 (2026-12-04): the backends differ by
     // 6e-8 m up to step 60, then the splash parts them (2e-4 m at step 65, 0.39 m at step 150); a
     // 1e-7 m nudge of the disc's points on OpenMP alone parts two OpenMP runs as far (0.29 m at
     // step 150), so after the impact only rounding is compared, and it is chaotic.
