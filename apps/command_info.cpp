@@ -6,6 +6,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "apps/scene_builder.hpp"
+#include "apps/speed_limit.hpp"
 #include "backend/backend_registry.hpp"
 #include "backend/errors.hpp"
 
@@ -38,6 +39,7 @@ int command_info(int argc, char** argv) {
     const ParticleCounts counts = count_particles(setup);
     const std::unique_ptr<Simulation> probe = probe_on_host(setup, backend);
     const std::size_t bytes = probe->device_bytes();
+    const SpeedLimit runaway = speed_limit(scene, setup);
     const std::vector<std::string> stages = probe->stage_names();
     const double bytes_per_particle = counts.total() ? double(bytes) / double(counts.total()) : 0.0;
     const SolverParams& solver = scene.params.solver;
@@ -67,6 +69,7 @@ int command_info(int argc, char** argv) {
         if (scene.params.heat.enabled)  // the sub-steps the largest step needs, before heat.max_substeps
             j["heat_substeps_needed"] = probe->heat_substeps_needed(double(solver.dt));
         j["frames"] = frames;
+        j["speed_limit"] = runaway.limit > 0 ? SceneJson(runaway.limit) : SceneJson(nullptr);  // m/s
         if (!setup.emitters.empty()) {
             SceneJson list = SceneJson::array();
             for (const EmitterSetup& e : setup.emitters)
@@ -118,6 +121,11 @@ int command_info(int argc, char** argv) {
                     double(solver.dt), static_cast<long>(std::ceil(scene.end_time / solver.dt - 1e-9)), scene.end_time,
                     stopping_rule, solver.min_iterations, solver.max_iterations);
     std::printf("run         to t=%g s; %ld frames (%g per simulated second)\n", scene.end_time, frames, scene.fps);
+    std::printf("guards      the run stops at a peak density error above %g (solver.max_density_error)",
+                scene.max_density_error);
+    if (scene.max_lost_fraction < 1)
+        std::printf("; more than %g%% of the fluid lost (boundary.max_lost_fraction)", 100 * scene.max_lost_fraction);
+    std::printf("; %s\n", speed_guard_text(runaway).c_str());
     if (scene.writes_surface())
         std::printf("surface     the fluid's surface with every frame (frames/surface_NNNNN.obj): its colour field on "
                     "nodes %g r0 apart, meshed%s\n",

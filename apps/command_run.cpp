@@ -13,6 +13,7 @@
 #include "apps/progress.hpp"
 #include "apps/run_outputs.hpp"
 #include "apps/scene_builder.hpp"
+#include "apps/speed_limit.hpp"
 #include "apps/atomic_file.hpp"
 #include "backend/backend_registry.hpp"
 #include "backend/errors.hpp"
@@ -83,6 +84,23 @@ std::string density_blowup_message(const StepReport& r, const StatsTable& stats,
     const std::string hint = failed_iterations_hint(stats);
     return head + ("solver.max_density_error " + format_number(scene.max_density_error)) +
            (!hint.empty() ? hint : std::string("; the run blew up (see the last frames and stats.csv)"));
+}
+
+std::string runaway_message(const StepReport& r, const SpeedLimit& limit, const StatsTable& stats) {
+    const bool solid = r.solid_max_speed > r.max_speed;
+    char head[400];
+    std::snprintf(head, sizeof head, "step %ld (t = %.6g s, dt = %.3g s): %s moves at %.4g m/s, more than "
+                  "solver.max_speed %.4g m/s",
+                  r.step, r.time, r.dt, solid ? "a solid's particle" : "a fluid particle",
+                  solid ? r.solid_max_speed : r.max_speed, limit.limit);
+    std::string text = head;
+    if (limit.automatic) {
+        std::snprintf(head, sizeof head, " (%g times the scene's %.3g m/s: its fastest start %.3g m/s and a fall "
+                      "through the domain %.3g m/s)", kRunawaySpeedFactor, limit.scale(), limit.start, limit.fall);
+        text += head;
+    }
+    const std::string hint = failed_iterations_hint(stats);
+    return text + (!hint.empty() ? hint : std::string("; the run blew up (see the last frames and stats.csv)"));
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -177,6 +195,7 @@ int command_run(int argc, char** argv) {
     long carved_fluid = 0;
     const SimulationSetup setup = build_setup(scene, &carved_fluid);
     if (g_interrupted) return report_interrupted_setup();
+    const SpeedLimit runaway = speed_limit(scene, setup);
     // Before the simulation is built, so that an unwritable --out fails at once; the directories
     // made here are removed again (if still empty) when the run ends before its first step.
     const std::vector<std::string> created = make_directories(out_dir);
@@ -227,6 +246,7 @@ int command_run(int argc, char** argv) {
     summary.particles = sim->counts();
     summary.fluid_carved = carved_fluid;
     summary.device_bytes = sim->device_bytes();
+    summary.speed_limit = runaway.limit;
     char stop[64];
     if (end_steps > 0) std::snprintf(stop, sizeof stop, "steps %ld", end_steps);
     else std::snprintf(stop, sizeof stop, "time %g s", end_time);
@@ -348,6 +368,10 @@ int command_run(int argc, char** argv) {
             if (r.density_error_max > scene.max_density_error) {
                 progress.finish();
                 throw SimulationError(density_blowup_message(r, stats, scene));
+            }
+            if (runaway.limit > 0 && std::max(r.max_speed, r.solid_max_speed) > runaway.limit) {
+                progress.finish();
+                throw SimulationError(runaway_message(r, runaway, stats));
             }
             if (r.time >= next_frame_time * (1 - 1e-9)) {
                 write_frame();

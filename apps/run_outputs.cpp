@@ -235,6 +235,7 @@ void StatsTable::add(const StepReport& r) {
     error_max_.push_back(r.density_error_max);
     iterations_.push_back(r.iterations);
     retried_steps_ += r.retries > 0;
+    peak_speed_ = std::max(peak_speed_, std::max(r.max_speed, r.solid_max_speed));
     diverged_steps_ += r.diverged;
     unconverged_steps_ += r.unconverged;
 }
@@ -346,6 +347,9 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     j["retried_steps"] = stats.retried_steps();
     j["diverged_steps"] = stats.diverged_steps();
     j["unconverged_steps"] = stats.unconverged_steps();
+    // The fastest particle of the run against the runaway guard's limit (null: no guard).
+    j["speed"] = {{"peak", finite_or_null(stats.peak_speed())},
+                  {"limit", run.speed_limit > 0 ? SceneJson(run.speed_limit) : SceneJson(nullptr)}};
     // Heat conduction: the heat content (stats.csv) should stay constant; its change over the run.
     if (stats.has_heat() && stats.rows() > 0) {
         const double first = stats.heat_content_first(), last = stats.heat_content_last();

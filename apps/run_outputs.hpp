@@ -88,6 +88,8 @@ class StatsTable {
     long diverged_steps() const { return diverged_steps_; }  // steps whose last PCISPH try diverged
     // steps whose last PCISPH try ran out of iterations above the tolerance
     long unconverged_steps() const { return unconverged_steps_; }
+    // The fastest particle, fluid or solid, over this run's steps, m/s.
+    double peak_speed() const { return peak_speed_; }
     double sum_total_ms() const;
     // With heat conduction: the heat content after this run's first step and after its last.
     bool has_heat() const { return heat_; }
@@ -103,6 +105,7 @@ class StatsTable {
    private:
     std::vector<std::string> stages_;
     bool heat_ = false;
+    double peak_speed_ = 0;
     double heat_first_ = 0, heat_last_ = 0;
     bool melting_ = false;
     long melted_last_ = 0;
@@ -128,6 +131,7 @@ struct RunSummary {
     ParticleCounts particles;
     long fluid_carved = 0;  // fluid particles left out where static boxes and objects stand
     std::size_t device_bytes = 0;
+    double speed_limit = 0;  // m/s: the runaway guard's (speed_limit.hpp); 0 when there is none
     int frames = 0;
     // Surface reconstruction (output.formats "surface"): meshes written, the median time one took
     // (colour field, copy and meshing; writing the file aside), and the last one's triangles.

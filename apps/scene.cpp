@@ -415,6 +415,7 @@ void read_solver(Section s, Scene& scene) {
         s.fail(s.key_path("max_iterations"), "must be >= min_iterations (" + std::to_string(p.min_iterations) +
                                                  "), got " + std::to_string(p.max_iterations));
     scene.max_density_error = s.number("max_density_error", 1.0, Range::positive());
+    scene.max_speed = s.optional_number("max_speed", Range::positive());
     s.finish();
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,10 @@ struct Scene {
     // density error above this. Since the walls' correction keeps the fluid inside them, a
     // blow-up no longer shows as lost fluid; it shows as fluid packed far above its rest density.
     double max_density_error = 1.0;
+    // solver.max_speed, m/s: the run stops (exit 4) at the first step that ends with a fluid
+    // particle or a solid's particle faster than this. None (null, the default): 20 times the
+    // scene's speed scale (speed_limit.hpp), so the limit follows the scene's size and gravity.
+    std::optional<double> max_speed;
     Real fluid_temperature = 20;  // fluid.temperature, °C: the fluid blocks' default
     std::vector<FluidBlock> fluid_blocks;
     std::vector<StaticBox> static_boxes;

@@ -607,17 +607,24 @@ TEST_CASE("guards: a speed whose square overflows stops the run as a failure") {
     CHECK(read_json(dir + "/summary.json")["status"] == "failed");
 }
 
+namespace {
+// The guards' blow-up, as the scene and overrides of a `run`: a 0.5 m column in a 0.7 m tall box
+// at a fixed 8 ms, four times the step it holds. PCISPH diverges from step 4 and the walls'
+// correction keeps the exploding fluid inside, so nothing is lost.
+std::string column_blowing_up() {
+    return std::string(MW_SOURCE_DIR) + "/scenes/hydrostatic_column.json" +
+           " --set 'domain.max=[0.2,0.7,0.2]' --set 'fluid_blocks.0.max=[0.2,0.5,0.2]'"
+           " --set 'output.formats=[]' --set solver.dt=0.008";
+}
+}  // namespace
+
 TEST_CASE("guards: a blow-up inside the walls stops on solver.max_density_error") {
-    // A 0.5 m column at a fixed 8 ms, four times the step it holds: PCISPH diverges from step 4
-    // and the walls' correction keeps the exploding fluid inside, so nothing is lost. Measured
-    // (2026-12-01): the peak density error passes 100% (the default) in step 7 and reaches 2,400%
-    // by step 25 if the run goes on; never above 5% at 2 ms.
-    const std::string column = std::string(MW_SOURCE_DIR) + "/scenes/hydrostatic_column.json";
-    const std::string taller = " --set 'domain.max=[0.2,0.7,0.2]' --set 'fluid_blocks.0.max=[0.2,0.5,0.2]'"
-                               " --set 'output.formats=[]' --set solver.dt=0.008";
+    // Measured (2026-12-01): the peak density error passes 100% (the default) in step 7 and
+    // reaches 2,400% by step 25 if the run goes on; never above 5% at 2 ms.
+    const std::string column = column_blowing_up();
     SUBCASE("the default limit stops it, naming the step, the error and the key") {
         const std::string dir = out_dir("blowup");
-        const Result r = run("run " + column + " --steps 40 --quiet --out " + dir + taller);
+        const Result r = run("run " + column + " --steps 40 --quiet --out " + dir);
         CAPTURE(r.err);
         CHECK(r.code == 4);
         CHECK(contains(r.err, "above its rest density, more than solver.max_density_error 1"));
@@ -629,16 +636,69 @@ TEST_CASE("guards: a blow-up inside the walls stops on solver.max_density_error"
     }
     SUBCASE("a limit it never reaches lets it finish") {
         const std::string dir = out_dir("blowup_allowed");
-        const Result r = run("run " + column + " --steps 10 --quiet --out " + dir + taller +
+        const Result r = run("run " + column + " --steps 10 --quiet --out " + dir +
                              " --set solver.max_density_error=1e9");
         CAPTURE(r.err);
         CHECK(r.code == 0);
+        // Thrown about by then (26 m/s measured), but not yet past solver.max_speed (next test).
+        const auto s = read_json(dir + "/summary.json");
+        CHECK(s["speed"]["peak"].get<double>() > 10);
+        CHECK(s["speed"]["peak"].get<double>() < s["speed"]["limit"].get<double>());
     }
     SUBCASE("out of range") {
         const Result r = run("run " + column + " --steps 1 --out " + out_dir("blowup_range") +
                              " --set solver.max_density_error=0");
         CHECK(r.code != 0);
         CHECK(contains(r.err, "solver.max_density_error"));
+    }
+}
+
+TEST_CASE("guards: a run whose fluid is thrown about stops on solver.max_speed") {
+    // The same column at 8 ms with the density guard lifted: measured (2026-12-04), its fastest
+    // particle reaches 26 m/s by step 10, 52 m/s in step 13, 83 m/s in step 19 (and 1e3 m/s and
+    // more later, while the CFL step of such a run would shrink towards its floor and the run
+    // would grind on). The scene's speed scale is a fall through its 0.7 m: sqrt(2 g 0.7) =
+    // 3.706 m/s, so the default limit is 74.1 m/s.
+    const std::string column = column_blowing_up(), blowing_up = " --set solver.max_density_error=1e9";
+    SUBCASE("the default limit, 20 times the scene's speed scale, stops it and says how it was set") {
+        const std::string dir = out_dir("runaway");
+        const Result r = run("run " + column + " --steps 40 --quiet --out " + dir + blowing_up);
+        CAPTURE(r.err);
+        CHECK(r.code == 4);
+        CHECK(contains(r.err, "a fluid particle moves at"));
+        CHECK(contains(r.err, "more than solver.max_speed 74.12 m/s (20 times the scene's 3.71 m/s"));
+        CHECK(contains(r.err, "PCISPH diverged"));
+        const auto s = read_json(dir + "/summary.json");
+        CHECK(s["status"] == "failed");
+        CHECK(s["steps"].get<long>() > 10);
+        CHECK(s["steps"].get<long>() < 40);
+        CHECK(s["speed"]["limit"].get<double>() == doctest::Approx(20 * std::sqrt(2 * 9.81 * 0.7)).epsilon(1e-6));
+        CHECK(s["speed"]["peak"].get<double>() > s["speed"]["limit"].get<double>());
+        CHECK(s["scene"]["solver"]["max_speed"].is_null());
+    }
+    SUBCASE("a limit given in m/s stops it where that limit is passed") {
+        const std::string dir = out_dir("runaway_50");
+        const Result r = run("run " + column + " --steps 40 --quiet --out " + dir + blowing_up +
+                             " --set solver.max_speed=50");
+        CAPTURE(r.err);
+        CHECK(r.code == 4);
+        CHECK(contains(r.err, "more than solver.max_speed 50 m/s;"));
+        const auto s = read_json(dir + "/summary.json");
+        CHECK(s["speed"]["limit"].get<double>() == 50);
+        CHECK(s["speed"]["peak"].get<double>() > 50);
+    }
+    SUBCASE("out of range") {
+        const Result r = run("run " + column + " --steps 1 --out " + out_dir("runaway_range") +
+                             " --set solver.max_speed=-1");
+        CHECK(r.code != 0);
+        CHECK(contains(r.err, "solver.max_speed: must be > 0, got -1"));
+    }
+    SUBCASE("no gravity, nothing moving and no emitter: no scale, so no default limit") {
+        const std::string dir = out_dir("runaway_none");
+        const Result r = run("run " + tiny() + " --steps 2 --quiet --out " + dir + " --set 'gravity=[0,0,0]'");
+        CAPTURE(r.err);
+        CHECK(r.code == 0);
+        CHECK(read_json(dir + "/summary.json")["speed"]["limit"].is_null());
     }
 }
 
