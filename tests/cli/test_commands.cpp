@@ -212,6 +212,11 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(contains(d.out, "stages"));
     CHECK(contains(d.out, "density error < 0.01 average, < 0.05 peak"));  // the stopping rule, default peak bound
     CHECK(contains(run("info --set solver.eta_max=0").out, "< 0.01 average (peak unbounded)"));
+    // The guards: the default dam break's domain is 1 m tall, so its speed scale is sqrt(2 g) m/s.
+    CHECK(contains(d.out, "guards      the run stops at a peak density error above 1 (solver.max_density_error); "
+                          "more than 1% of the fluid lost (boundary.max_lost_fraction); a particle faster than "
+                          "88.6 m/s (solver.max_speed: 20 times the scene's 4.43 m/s"));
+    CHECK(contains(run("info --set solver.max_speed=5").out, "a particle faster than 5 m/s (solver.max_speed)\n"));
 
     const Result t = run("info " + tiny() + " --json");
     CAPTURE(t.err);
@@ -222,6 +227,8 @@ TEST_CASE("info: the built-in default scene and a small one") {
     CHECK(j["device_bytes"].get<long>() > 0);
     CHECK(j["stages"].size() > 0);
     CHECK(j["scene"]["solver"]["eta"].get<double>() == doctest::Approx(0.01));
+    // The tiny scene's domain is 0.2 m tall.
+    CHECK(j["speed_limit"].get<double>() == doctest::Approx(20 * std::sqrt(2 * 9.81 * 0.2)));
 
     // A stage the scene does not need is not listed and holds no memory: viscosity is off by
     // default; switching it on adds the stage and its per-particle acceleration array.
