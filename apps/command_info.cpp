@@ -40,6 +40,7 @@ int command_info(int argc, char** argv) {
     const std::unique_ptr<Simulation> probe = probe_on_host(setup, backend);
     const std::size_t bytes = probe->device_bytes();
     const SpeedLimit runaway = speed_limit(scene, setup);
+    const std::string emitter_warning = emitter_overlap_warning(setup);
     const std::vector<std::string> stages = probe->stage_names();
     const double bytes_per_particle = counts.total() ? double(bytes) / double(counts.total()) : 0.0;
     const SolverParams& solver = scene.params.solver;
@@ -60,7 +61,7 @@ int command_info(int argc, char** argv) {
         j["fluid_carved"] = carved_fluid;
         if (scene.walls) j["wall_gap_m"] = wall_gap;  // the first wall layer's distance outside the faces
         j["warnings"] = SceneJson::array();
-        for (const std::string& warning : {scene.kernel_warning(), heat_warning})
+        for (const std::string& warning : {scene.kernel_warning(), heat_warning, emitter_warning})
             if (!warning.empty()) j["warnings"].push_back(warning);
         j["backend"] = backend;
         j["device_bytes"] = bytes;
@@ -233,7 +234,7 @@ int command_info(int argc, char** argv) {
                     std::min(probe->heat_substeps_needed(double(solver.dt)), scene.params.heat.max_substeps),
                     scene.params.heat.max_substeps);
     }
-    for (const std::string& warning : {scene.kernel_warning(), heat_warning})
+    for (const std::string& warning : {scene.kernel_warning(), heat_warning, emitter_warning})
         if (!warning.empty()) std::printf("warning     %s\n", warning.c_str());
     return 0;
 }

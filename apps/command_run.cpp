@@ -196,6 +196,7 @@ int command_run(int argc, char** argv) {
     const SimulationSetup setup = build_setup(scene, &carved_fluid);
     if (g_interrupted) return report_interrupted_setup();
     const SpeedLimit runaway = speed_limit(scene, setup);
+    const std::string emitter_warning = emitter_overlap_warning(setup);
     // Before the simulation is built, so that an unwritable --out fails at once; the directories
     // made here are removed again (if still empty) when the run ends before its first step.
     const std::vector<std::string> created = make_directories(out_dir);
@@ -260,7 +261,7 @@ int command_run(int argc, char** argv) {
 
     const std::string heat_warning =
         heat_substeps_warning(sim->heat_substeps_needed(double(scene.params.solver.dt)), scene.params.heat.max_substeps);
-    for (const std::string& warning : {scene.kernel_warning(), heat_warning}) {
+    for (const std::string& warning : {scene.kernel_warning(), heat_warning, emitter_warning}) {
         if (warning.empty()) continue;
         std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
         summary.warnings.push_back(warning);

@@ -488,4 +488,47 @@ ParticleCounts count_particles(const SimulationSetup& setup) {
     return c;
 }
 
+std::string emitter_overlap_warning(const SimulationSetup& setup) {
+    // Closer than the rest spacing r0, less a margin for rounding: the layer would be denser than rest.
+    const double reach = 0.9 * double(setup.params.fluid.spacing);
+    for (std::size_t k = 0; k < setup.emitters.size(); ++k) {
+        const EmitterSetup& e = setup.emitters[k];
+        // The disc's points, and their box grown by the reach: most particles fail the box test.
+        Eigen::AlignedBox3d box;
+        for (const Vec3& offset : e.offsets) {
+            const Vec3 x = e.center + offset;
+            box.extend(Eigen::Vector3d(x.x, x.y, x.z));
+        }
+        box.min().array() -= reach;
+        box.max().array() += reach;
+        long overlapping = 0;
+        double nearest = reach;
+        std::uint8_t nearest_type = kFluid;
+        for (std::size_t i = 0; i < setup.position.size(); ++i) {
+            const Vec3 x = setup.position[i];
+            if (setup.type[i] == kPending || !box.contains(Eigen::Vector3d(x.x, x.y, x.z))) continue;
+            double closest = reach;
+            for (const Vec3& offset : e.offsets) closest = std::min(closest, double(norm(x - (e.center + offset))));
+            if (closest >= reach) continue;
+            ++overlapping;
+            if (closest < nearest) {
+                nearest = closest;
+                nearest_type = setup.type[i];
+            }
+        }
+        if (overlapping == 0) continue;
+        char text[400];
+        const char* what = nearest_type == kFluid             ? "fluid particle"
+                           : nearest_type == kStaticBoundary ? "particle of a wall or a static box"
+                                                             : "particle of an object";
+        std::snprintf(text, sizeof text,
+                      "emitters[%zu] (%s): its disc starts closer than 0.9 r0 to %ld particle(s) of the scene (the "
+                      "nearest a %s, %.3g m from it), so its layers would be released on top of them; move the "
+                      "disc clear of the fluid and the solids (docs/scenes.md, \"Emitters\")",
+                      k, e.name.c_str(), overlapping, what, nearest);
+        return text;
+    }
+    return "";
+}
+
 }  // namespace mw

@@ -70,4 +70,9 @@ TriangleMesh object_mesh(const Scene& scene, const SceneObject& object);
 // Particle counts of a setup by type.
 ParticleCounts count_particles(const SimulationSetup& setup);
 
+// A warning ("" if none) for the first emitter whose disc starts closer than 0.9 r0 to a
+// particle of the scene (fluid, a wall, a box, an object): its layers would be released on top of
+// that particle. Nothing else keeps a disc clear (algorithms/emitter.hpp).
+std::string emitter_overlap_warning(const SimulationSetup& setup);
+
 }  // namespace mw

@@ -89,6 +89,29 @@ TEST_CASE("a scene may have emitters and no fluid block") {
     CHECK(info_json(scene)["scene"]["emitters"][0]["name"] == "emitter0");
 }
 
+TEST_CASE("an emitter whose disc starts inside the fluid is warned about, by info and run") {
+    // The tiny block fills x, y, z < 0.1 m at r0 = 0.02 m, its particles at odd hundredths of a
+    // metre. The tap's disc (points r0 apart) centred at (0.06, 0.05, 0.06) lies inside the block,
+    // 0.71 r0 from its nearest particles; at y = 0.11 m it is one spacing over the top layer
+    // (y = 0.09 m) and 1.22 r0 from it.
+    const std::string scene = tap_scene("emitter_inside.json");
+    const std::string inside = " --set 'emitters.0.center=[0.06,0.05,0.06]'";
+    const nlohmann::json info = info_json(scene, inside);
+    REQUIRE(info["warnings"].size() == 1);
+    const std::string warning = info["warnings"][0].get<std::string>();
+    CHECK(contains(warning, "emitters[0] (tap): its disc starts closer than 0.9 r0 to"));
+    CHECK(contains(warning, "the nearest a fluid particle, 0.0141 m from it"));
+    CHECK(contains(run("info " + scene + inside).out, "warning     emitters[0] (tap)"));
+    const std::string out = out_dir("emitter_inside");
+    const Result r = run("run " + scene + inside + " --steps 1 --quiet --out " + out);
+    CHECK(r.code == 0);  // a warning: the run goes on
+    CHECK(contains(r.err, "meltwater: warning: emitters[0] (tap)"));
+    CHECK(read_json(out + "/summary.json")["warnings"].size() == 1);
+    // One spacing over the fluid, and the tap of the other tests: no warning.
+    CHECK(info_json(scene, " --set 'emitters.0.center=[0.06,0.11,0.06]'")["warnings"].empty());
+    CHECK(info_json(scene)["warnings"].empty());
+}
+
 TEST_CASE("bad input: emitter keys") {
     const std::string base = R"("center": [0.15, 0.16, 0.1], "direction": [0, -1, 0], "radius": 0.03, "speed": 1.0)";
     auto with = [&](const std::string& name, const std::string& keys) {
