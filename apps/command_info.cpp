@@ -126,7 +126,8 @@ int command_info(int argc, char** argv) {
                 scene.max_density_error);
     if (scene.max_lost_fraction < 1)
         std::printf("; more than %g%% of the fluid lost (boundary.max_lost_fraction)", 100 * scene.max_lost_fraction);
-    std::printf("; %s\n", speed_guard_text(runaway).c_str());
+    if (runaway.limit > 0) std::printf("; a particle faster than %s\n", describe(runaway).c_str());
+    else std::printf("; no speed limit (solver.max_speed: no gravity, motion or emitter to scale one by)\n");
     if (scene.writes_surface())
         std::printf("surface     the fluid's surface with every frame (frames/surface_NNNNN.obj): its colour field on "
                     "nodes %g r0 apart, meshed%s\n",

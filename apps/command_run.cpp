@@ -88,19 +88,13 @@ std::string density_blowup_message(const StepReport& r, const StatsTable& stats,
 
 std::string runaway_message(const StepReport& r, const SpeedLimit& limit, const StatsTable& stats) {
     const bool solid = r.solid_max_speed > r.max_speed;
-    char head[400];
-    std::snprintf(head, sizeof head, "step %ld (t = %.6g s, dt = %.3g s): %s moves at %.4g m/s, more than "
-                  "solver.max_speed %.4g m/s",
-                  r.step, r.time, r.dt, solid ? "a solid's particle" : "a fluid particle",
-                  solid ? r.solid_max_speed : r.max_speed, limit.limit);
-    std::string text = head;
-    if (limit.automatic) {
-        std::snprintf(head, sizeof head, " (%g times the scene's %.3g m/s: its fastest start %.3g m/s and a fall "
-                      "through the domain %.3g m/s)", kRunawaySpeedFactor, limit.scale(), limit.start, limit.fall);
-        text += head;
-    }
+    char head[200];
+    std::snprintf(head, sizeof head, "step %ld (t = %.6g s, dt = %.3g s): %s moves at %.4g m/s, more than ", r.step,
+                  r.time, r.dt, solid ? "a solid's particle" : "a fluid particle",
+                  solid ? r.solid_max_speed : r.max_speed);
     const std::string hint = failed_iterations_hint(stats);
-    return text + (!hint.empty() ? hint : std::string("; the run blew up (see the last frames and stats.csv)"));
+    return head + describe(limit) +
+           (!hint.empty() ? hint : std::string("; the run blew up (see the last frames and stats.csv)"));
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t) {

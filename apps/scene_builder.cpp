@@ -10,6 +10,7 @@
 #include "sampling/box_particles.hpp"
 #include "sampling/disc_lattice.hpp"
 #include "sampling/inside_outside.hpp"
+#include "sampling/kdtree.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/signed_distance.hpp"
@@ -491,24 +492,23 @@ ParticleCounts count_particles(const SimulationSetup& setup) {
 std::string emitter_overlap_warning(const SimulationSetup& setup) {
     // Closer than the rest spacing r0, less a margin for rounding: the layer would be denser than rest.
     const double reach = 0.9 * double(setup.params.fluid.spacing);
+    const auto to_vec3d = [](Vec3 x) { return Vec3d(x.x, x.y, x.z); };
     for (std::size_t k = 0; k < setup.emitters.size(); ++k) {
         const EmitterSetup& e = setup.emitters[k];
         // The disc's points, and their box grown by the reach: most particles fail the box test.
+        std::vector<Vec3d> disc;
         Eigen::AlignedBox3d box;
-        for (const Vec3& offset : e.offsets) {
-            const Vec3 x = e.center + offset;
-            box.extend(Eigen::Vector3d(x.x, x.y, x.z));
-        }
+        for (const Vec3& offset : e.offsets) box.extend(disc.emplace_back(to_vec3d(e.center + offset)));
         box.min().array() -= reach;
         box.max().array() += reach;
+        const PointTree tree(disc);
         long overlapping = 0;
         double nearest = reach;
         std::uint8_t nearest_type = kFluid;
         for (std::size_t i = 0; i < setup.position.size(); ++i) {
-            const Vec3 x = setup.position[i];
-            if (setup.type[i] == kPending || !box.contains(Eigen::Vector3d(x.x, x.y, x.z))) continue;
-            double closest = reach;
-            for (const Vec3& offset : e.offsets) closest = std::min(closest, double(norm(x - (e.center + offset))));
+            const Vec3d x = to_vec3d(setup.position[i]);
+            if (setup.type[i] == kPending || !box.contains(x)) continue;
+            const double closest = tree.nearest(x).second;
             if (closest >= reach) continue;
             ++overlapping;
             if (closest < nearest) {
@@ -519,8 +519,8 @@ std::string emitter_overlap_warning(const SimulationSetup& setup) {
         if (overlapping == 0) continue;
         char text[400];
         const char* what = nearest_type == kFluid             ? "fluid particle"
-                           : nearest_type == kStaticBoundary ? "particle of a wall or a static box"
-                                                             : "particle of an object";
+                           : nearest_type == kStaticBoundary ? "particle of a wall, a static box or a static object"
+                                                             : "particle of a moving object";
         std::snprintf(text, sizeof text,
                       "emitters[%zu] (%s): its disc starts closer than 0.9 r0 to %ld particle(s) of the scene (the "
                       "nearest a %s, %.3g m from it), so its layers would be released on top of them; move the "

@@ -27,17 +27,15 @@ SpeedLimit speed_limit(const Scene& scene, const SimulationSetup& setup) {
     return out;
 }
 
-std::string speed_guard_text(const SpeedLimit& limit) {
+std::string describe(const SpeedLimit& limit) {
     char text[300];
-    if (limit.limit <= 0)
-        return "no speed limit (solver.max_speed: no gravity, motion or emitter to scale one by)";
     if (limit.automatic)
         std::snprintf(text, sizeof text,
-                      "a particle faster than %.3g m/s (solver.max_speed: %g times the scene's %.3g m/s, its fastest "
-                      "start %.3g m/s and a fall through the domain %.3g m/s)",
+                      "solver.max_speed %.4g m/s (%g times the scene's %.3g m/s: its fastest start %.3g m/s and a "
+                      "fall through the domain %.3g m/s)",
                       limit.limit, kRunawaySpeedFactor, limit.scale(), limit.start, limit.fall);
     else
-        std::snprintf(text, sizeof text, "a particle faster than %.3g m/s (solver.max_speed)", limit.limit);
+        std::snprintf(text, sizeof text, "solver.max_speed %.4g m/s", limit.limit);
     return text;
 }
 

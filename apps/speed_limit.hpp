@@ -26,7 +26,8 @@ struct SpeedLimit {
 
 SpeedLimit speed_limit(const Scene& scene, const SimulationSetup& setup);
 
-// For `meltwater info`: "a particle faster than 74.1 m/s (solver.max_speed: 20 times ...)".
-std::string speed_guard_text(const SpeedLimit& limit);
+// The limit and where it came from, as `info` and the run's stop message say it:
+// "solver.max_speed 74.12 m/s (20 times the scene's 3.71 m/s: ...)", or "solver.max_speed 50 m/s".
+std::string describe(const SpeedLimit& limit);
 
 }  // namespace mw

@@ -50,13 +50,14 @@ SimulationSetup hanging_layer(Real eta, int numbered_after = 0) {
     return setup;
 }
 
-// The fluid's mean height in `p`, and its particle count in `n`.
-double mean_fluid_height(const HostParticles& p, long& n) {
+// The mean height of the fluid among particles (`position`, `type`: a setup's or a download's),
+// and its particle count in `n`.
+double mean_fluid_height(const std::vector<Vec3>& position, const std::vector<std::uint8_t>& type, long& n) {
     double sum = 0;
     n = 0;
-    for (std::size_t i = 0; i < p.position.size(); ++i)
-        if (p.type[i] == kFluid) {
-            sum += p.position[i].y;
+    for (std::size_t i = 0; i < position.size(); ++i)
+        if (type[i] == kFluid) {
+            sum += position[i].y;
             ++n;
         }
     return sum / double(n);
@@ -68,7 +69,7 @@ Hanging hang(Real eta, double seconds, int numbered_after = 0) {
     HostParticles p;
     auto mean_height = [&](long& n) {
         sim->download(p);
-        return mean_fluid_height(p, n);
+        return mean_fluid_height(p.position, p.type, n);
     };
     Hanging out;
     const double start = mean_height(out.fluid);
@@ -163,11 +164,9 @@ TEST_CASE("CUDA and OpenMP agree on interface tension: the hanging layer, 250 st
     const double domain_size = norm(setup.params.domain_max - setup.params.domain_min);
     const double worst = test::largest_position_difference(a, b);
     long n_openmp = 0, n_cuda = 0, n_start = 0;
-    HostParticles start;
-    create_openmp_simulation(setup, 0)->download(start);
-    const double height0 = mean_fluid_height(start, n_start);
-    const double drop_openmp = height0 - mean_fluid_height(a, n_openmp);
-    const double drop_cuda = height0 - mean_fluid_height(b, n_cuda);
+    const double height0 = mean_fluid_height(setup.position, setup.type, n_start);
+    const double drop_openmp = height0 - mean_fluid_height(a.position, a.type, n_openmp);
+    const double drop_cuda = height0 - mean_fluid_height(b.position, b.type, n_cuda);
     MESSAGE("largest position difference after 250 steps: " << worst << " m; the layer moved " << drop_openmp
                                                             << " m (OpenMP), " << drop_cuda << " m (CUDA)");
     CHECK(worst < 1e-4 * domain_size);
