@@ -109,13 +109,13 @@ struct FluidPairs {
 };
 
 template <class Kernel>
-void fluid_reaction_on_solids(const FluidPairs pairs, const CouplingData d, View<const Vec3> position,
+void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pairs, const CouplingData d, View<const Vec3> position,
                               View<const Vec3> velocity, View<const Vec3> predicted, View<const Real> boundary_volume,
                               View<const Real> pressure_term, FluidConstants<Kernel> c, bool friction) {
     const Real pressure_scale = c.mass * c.rest_density;         // m ρ0 (ψ_b = ρ0 V_b)
     const Real friction_scale = -c.mass * c.wall_viscosity / c.rest_density;  // -m μ_w / ρ0
     const bool lists = pairs.list_radius2 > Real(0);
-    parallel_for("coupling_reaction", std::size_t(d.ibp_count) + d.sbp_count, [=] MW_HD(std::size_t s) {
+    parallel_for(device, "coupling_reaction", std::size_t(d.ibp_count) + d.sbp_count, [=] MW_HD(std::size_t s) {
         const std::uint32_t b = d.store_of_slot[s];
         // A solid particle that left the grid (counted as lost) meets no fluid.
         if (b < pairs.fluid_end || b >= pairs.solid_end) {
@@ -148,8 +148,8 @@ void fluid_reaction_on_solids(const FluidPairs pairs, const CouplingData d, View
 }
 
 // Each IBP's force: its own reaction and its shares of the SBPs' (see the top of the file).
-inline void gather_solid_forces(const CouplingData d) {
-    parallel_for("coupling_to_ibps", d.ibp_count, [=] MW_HD(std::size_t s) {
+inline void gather_solid_forces(const DeviceContext& device, const CouplingData d) {
+    parallel_for(device, "coupling_to_ibps", d.ibp_count, [=] MW_HD(std::size_t s) {
         Vec3 f = d.reaction[s];
         for (std::uint32_t e = d.share_offsets[s]; e < d.share_offsets[s + 1]; ++e)
             f += d.share_weight[e] * d.reaction[d.ibp_count + d.share_sbp[e]];

@@ -24,9 +24,10 @@
 #include <string>
 #include <vector>
 
+#include "algorithms/module.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "algorithms/state_archive.hpp"
 #include "backend/backend.hpp"
 
@@ -66,8 +67,8 @@ struct EmissionData {
 
 // Over the store's particles [begin, end) (the inactive group, where the pending particles are):
 // each pending particle whose id is in a window becomes fluid at its layer's place.
-inline void release_layers(std::size_t begin, std::size_t end, const EmitterWindows windows, const EmissionData d) {
-    parallel_for("emitter_release", end - begin, [=] MW_HD(std::size_t k) {
+inline void release_layers(const DeviceContext& device, std::size_t begin, std::size_t end, const EmitterWindows windows, const EmissionData d) {
+    parallel_for(device, "emitter_release", end - begin, [=] MW_HD(std::size_t k) {
         const std::size_t i = begin + k;
         if (d.type[i] != kPending) return;
         const std::uint32_t id = d.id[i];
@@ -88,12 +89,17 @@ inline void release_layers(std::size_t begin, std::size_t end, const EmitterWind
     });
 }
 
-// The stage: the emitters' layers, and how many each has released.
-class FluidEmitters {
+// The emitters module (stage "emit", with an emitter): the emitters' layers, and how many each
+// has released.
+class FluidEmitters final : public Module {
    public:
     // Checks the setup's emitters (their particles must be pending, layer by layer, as
     // EmitterSetup says) and uploads their layers' points. Throws InputError naming the emitter.
-    void init(const SimulationSetup& setup, Real spacing) {
+    // The heat's store field `temperature`, when there is one, takes the streams' temperatures.
+    FluidEmitters(const DeviceContext& device, const SimulationSetup& setup, ParticleStore& store,
+                  ParticleCounts& counts, Real rest_density, Vec3 gravity)
+        : device_(device), store_(store), counts_(counts), rest_density_(rest_density), gravity_(gravity) {
+        const Real spacing = setup.params.fluid.spacing;
         if (setup.emitters.size() > kMaxEmitters)
             throw InputError("simulation setup: " + std::to_string(setup.emitters.size()) + " emitters, at most " +
                              std::to_string(kMaxEmitters) + " are supported");
@@ -124,8 +130,28 @@ class FluidEmitters {
         }
         released_.assign(emitters_.size(), 0);
         if (!offsets.empty()) offsets_.upload(offsets);
+        temperature_ = store.find<Real>("temperature");
     }
     bool active() const { return !emitters_.empty(); }
+
+    void bind(StepPlan& plan) override {
+        if (active()) plan.bind("emit", [this](StepContext& step) { emit(step); });
+    }
+    // The layers due by the step's end leave their discs as fluid (the next step's sort moves them
+    // to the fluid's range).
+    void emit(StepContext& step) {
+        step.released =
+            this->step(store_, step.ranges.solid_end, step.time + step.dt, gravity_, rest_density_, temperature_);
+        counts_.by_type[kFluid] += step.released;
+        counts_.by_type[kPending] -= step.released;
+    }
+    double speed_to_come(double time) const override { return fastest_after(time); }
+    void report_columns(std::vector<std::string>& names) const override {
+        if (active()) names.push_back("emitted");
+    }
+    void report(std::vector<double>& values) const override {
+        if (active()) values.push_back(double(released_total_));
+    }
 
     // Releases every layer due by `time_after` (the step's end); returns how many particles.
     long step(ParticleStore& store, std::size_t inactive_begin, double time_after, Vec3 gravity, Real rest_density,
@@ -155,7 +181,7 @@ class FluidEmitters {
         d.rest_density = rest_density;
         d.gravity = gravity;
         d.time_after = time_after;
-        release_layers(inactive_begin, store.moving_count(), windows, d);
+        release_layers(device_, inactive_begin, store.moving_count(), windows, d);
         released_total_ += released;
         return released;
     }
@@ -176,9 +202,11 @@ class FluidEmitters {
         return fastest;
     }
 
-    void save(StateArchive& out) const { out.put("emitters.released_layers", released_); }
+    void save(StateArchive& out) const override {
+        if (active()) out.put("emitters.released_layers", released_);
+    }
     // After the store is loaded: the layers released so far (its pending particles must match).
-    void load(const StateArchive& in) {
+    void load(const StateArchive& in) override {
         if (emitters_.empty()) return;
         released_ = in.get_sized<std::uint32_t>("emitters.released_layers", emitters_.size());
         released_total_ = 0;
@@ -186,9 +214,11 @@ class FluidEmitters {
             if (released_[k] > layers_[k]) throw InputError("checkpoint: an emitter released more layers than it has");
             released_total_ += long(released_[k]) * long(emitters_[k].per_layer);
         }
+        if (counts_.by_type[kPending] != capacity() - released_total_)
+            throw InputError("checkpoint: its pending particles do not match its emitters' released layers");
     }
 
-    std::size_t bytes() const { return offsets_.bytes(); }
+    std::size_t bytes() const override { return offsets_.bytes(); }
 
    private:
     // Layers of emitter k that have left by `time`: t_k <= time for k = 0, 1, ..., at most all.
@@ -200,6 +230,12 @@ class FluidEmitters {
         return due >= double(layers_[k]) ? layers_[k] : static_cast<std::uint32_t>(due);
     }
 
+    const DeviceContext& device_;
+    ParticleStore& store_;
+    ParticleCounts& counts_;
+    Real rest_density_ = 0;
+    Vec3 gravity_{0, 0, 0};
+    DeviceArray<Real>* temperature_ = nullptr;  // the heat's store field, with heat conduction
     std::vector<EmitterWindow> emitters_;  // base ids, layer geometry, timing
     std::vector<std::uint32_t> layers_;    // per emitter: its layers in all
     std::vector<std::uint32_t> released_;  // per emitter: layers released so far

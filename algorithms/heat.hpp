@@ -42,10 +42,14 @@
 #include <cmath>
 #include <cstdint>
 
-#include "algorithms/neighbor_grid.hpp"
-#include "algorithms/neighbor_list.hpp"
+#include <string>
+#include <vector>
+
+#include "algorithms/boundary_volumes.hpp"
+#include "algorithms/module.hpp"
 #include "algorithms/particle_types.hpp"
-#include "backend/backend.hpp"
+#include "algorithms/pcisph_delta.hpp"
+#include "algorithms/solid_bodies.hpp"
 #include "backend/reduce_ops.hpp"
 
 MW_BACKEND_BEGIN
@@ -124,10 +128,10 @@ MW_INLINE Real heat_pair(Vec3 xi, Real k_i, Real gamma_i, std::uint32_t j, std::
 // with c_ij = k_ij V_j F_ij over the conducting particles [0, end). Otherwise branch-free terms
 // (F is 0 out of range and for i itself), as in the PCISPH sums.
 template <class Neighbors, class Kernel>
-void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t count, std::size_t end,
+void heat_substep(const DeviceContext& device, const Neighbors& neighbors, std::size_t first, std::size_t count, std::size_t end,
                   View<const Vec3> position, View<const HeatParticle> particle, View<const Real> in, View<Real> out,
                   Real dt_times_scale, Kernel kernel) {
-    parallel_for("heat_substep", count, [=] MW_HD(std::size_t k) {
+    parallel_for(device, "heat_substep", count, [=] MW_HD(std::size_t k) {
         const std::size_t i = first + k;
         const Vec3 xi = position[i];
         const Real k_i = particle[i].conductivity, gamma_i = particle[i].deficiency;
@@ -145,103 +149,181 @@ void heat_substep(const Neighbors& neighbors, std::size_t first, std::size_t cou
 
 // The heat content Σ M (T + latent) of particles [0, count), J (T in °C), in double; `latent`
 // (melting.hpp) may be empty.
-inline double heat_content(std::size_t count, View<const HeatParticle> particle, View<const Real> temperature,
+inline double heat_content(const DeviceContext& device, std::size_t count, View<const HeatParticle> particle, View<const Real> temperature,
                            View<const Real> latent) {
     const bool has_latent = latent.data() != nullptr;
-    return transform_reduce("heat_content", count, 0.0, SumOp{}, [=] MW_HD(std::size_t i) {
+    return transform_reduce(device, "heat_content", count, 0.0, SumOp{}, [=] MW_HD(std::size_t i) {
         const double stored = has_latent ? double(latent[i]) : 0.0;
         return double(particle[i].capacity) * (double(temperature[i]) + stored);
     });
 }
 
-// The heat stage's own buffers and its sub-steps.
-class HeatConduction {
+// The heat conduction module (stage "heat", with heat.enabled): the store's "temperature" field,
+// each object's material, and the sub-steps' buffers.
+template <class Kernel>
+class HeatConduction final : public Module {
    public:
-    // `moving`: the store's moving particles (the most a pass covers); `lattice_scale`: s above.
-    // calibrate() then sets the sub-steps' scale.
-    void init(std::size_t moving, int max_substeps, double lattice_scale) {
-        max_substeps_ = std::max(1, max_substeps);
-        lattice_scale_ = lattice_scale;
+    // Registers the store field `temperature`, filled from the setup in the store's order `order`.
+    // Throws InputError for a non-finite temperature or material.
+    HeatConduction(SimulationState<Kernel>& state, const SimulationSetup& setup, const std::vector<std::uint32_t>& order,
+                   BoundaryVolumes<Kernel>& volumes, const SolidBodies& solids)
+        : state_(state), volumes_(volumes), solids_(solids) {
+        const SimulationParams& params = state.params;
+        if (!params.heat.enabled) return;
+        const std::size_t n = order.size(), moving = state.store.moving_count();
+        if (setup.temperature.size() != n)
+            throw InputError("simulation setup: heat conduction needs a temperature for each of the " +
+                             std::to_string(n) + " particles (got " + std::to_string(setup.temperature.size()) + ")");
+        std::vector<Real> temperature(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            temperature[k] = setup.temperature[order[k]];
+            if (!std::isfinite(double(temperature[k])))
+                throw InputError("simulation setup: particle " + std::to_string(order[k]) +
+                                 " has a non-finite temperature");
+        }
+        if (!(params.heat.fluid_diffusivity >= 0) || !std::isfinite(double(params.heat.fluid_diffusivity)))
+            throw InputError("simulation setup: the fluid's thermal diffusivity must be finite and >= 0");
+        if (!(params.heat.fluid_capacity > 0) || !std::isfinite(double(params.heat.fluid_capacity)))
+            throw InputError("simulation setup: the fluid's heat capacity must be finite and > 0");
+        std::vector<HeatMaterial> materials;
+        for (const SolidSetup& solid : setup.solids) {
+            if (!(solid.thermal_diffusivity >= 0) || !std::isfinite(double(solid.thermal_diffusivity)))
+                throw InputError("simulation setup: solid \"" + solid.name +
+                                 "\" has a thermal diffusivity that is not finite and >= 0");
+            if (!(solid.heat_capacity > 0) || !std::isfinite(double(solid.heat_capacity)))
+                throw InputError("simulation setup: solid \"" + solid.name +
+                                 "\" has a heat capacity that is not finite and > 0");
+            materials.push_back(HeatMaterial{solid.thermal_diffusivity, solid.heat_capacity});
+        }
+        if (params.heat.max_substeps < 1)
+            throw InputError("simulation setup: heat conduction needs max_substeps >= 1");
+        temperature_ = &state.store.template add<Real>("temperature", FieldLife::kPersistent);
+        temperature_->upload(temperature);
+        object_heat_.upload(materials);
+        max_substeps_ = params.heat.max_substeps;
+        // Brookshaw's Laplacian, rescaled to be exact on the fluid's lattice (pcisph_delta.hpp).
+        lattice_scale_ = heat_lattice_scale(prototype_sums(state.fluid.kernel, params.fluid.spacing, 3));
         particle_.assign(moving, HeatParticle{});
         other_.assign(moving, Real(0));
-        solid_rest_volume_.assign(1, Real(0));  // calibrate() sizes it
-        heat_content(moving, particle_.cview(), other_.cview(), View<const Real>{});  // its reduction workspace, before the first step
+        solid_rest_volume_.assign(1, Real(0));  // start() sizes it
+        heat_content(state.device, moving, particle_.cview(), other_.cview(), View<const Real>{});  // its reduction workspace
     }
-    // At set-up, with the scene's first volumes and grid: each solid particle's V⁰ (its V_b now),
-    // and the largest g / Δt over particles [0, solid_end) (4.33 α / r0² in a fluid at rest for the
-    // cubic spline at h = 2 r0; the solids' overlapping surface and inner particles reach 1.6 times
-    // their material's). One neighbour pass and a reduction.
-    template <class Kernel>
-    void calibrate(const GridView& grid, std::size_t fluid_end, std::size_t solid_end, View<const Vec3> position,
-                   const HeatMaterials& m, Kernel kernel) {
+
+    bool active() const { return temperature_ != nullptr; }
+    DeviceArray<Real>* temperature() { return temperature_; }
+
+    void bind(StepPlan& plan) override {
+        if (active()) plan.bind("heat", [this](StepContext& step) { conduct(step); });
+    }
+
+    // With the scene's first volumes and grid: each solid particle's V0 (its V_b now), and the
+    // largest g / dt over particles [0, solid_end) (4.33 alpha / r0^2 in a fluid at rest for the
+    // cubic spline at h = 2 r0; the solids' overlapping surface and inner particles reach 1.6
+    // times their material's). One neighbour pass and a reduction.
+    void start(const StepContext& first) override {
+        if (!active()) return;
+        latent_ = state_.store.template find<Real>("latent_heat");  // melting.hpp's, when an object melts
+        if (solids_.active()) volumes_.update_moving(first.neighbors.grid, first.ranges);
+        const HeatMaterials m = materials();
+        const std::size_t fluid_end = first.ranges.fluid_end, solid_end = first.ranges.solid_end;
         solid_rest_volume_.assign(std::max<std::size_t>(1, m.solid_slots), Real(0));
         if (solid_end == 0) return;
         const View<Real> rest = solid_rest_volume_.view();
         if (solid_end > fluid_end)
-            parallel_for("heat_solid_rest_volume", solid_end - fluid_end, [=] MW_HD(std::size_t k) {
+            parallel_for(state_.device, "heat_solid_rest_volume", solid_end - fluid_end, [=] MW_HD(std::size_t k) {
                 const std::size_t i = fluid_end + k;
                 rest[static_cast<std::size_t>(m.solid_slot[i])] = m.boundary_volume[i];
             });
         describe_particles(solid_end, m, View<const Real>{});
         const View<const HeatParticle> particle = particle_.cview();
+        const View<const Vec3> position = state_.store.position.cview();
+        const GridView grid = first.neighbors.grid;
+        const Kernel kernel = state_.fluid.kernel;
         const Real two_s = static_cast<Real>(2 * lattice_scale_);
-        const Real largest = transform_reduce("heat_calibrate", solid_end, Real(0), MaxOp{}, [=] MW_HD(std::size_t i) {
-            const Vec3 xi = position[i];
-            const Real k_i = particle[i].conductivity, gamma_i = particle[i].deficiency;
-            const HeatSums sums = sum_conducting(grid, i, xi, [&](std::uint32_t j) {
-                std::uint32_t read = 0;
-                return HeatSums{heat_pair(xi, k_i, gamma_i, j, solid_end, position, particle, kernel, read), Real(0)};
+        const Real largest =
+            transform_reduce(state_.device, "heat_calibrate", solid_end, Real(0), MaxOp{}, [=] MW_HD(std::size_t i) {
+                const Vec3 xi = position[i];
+                const Real k_i = particle[i].conductivity, gamma_i = particle[i].deficiency;
+                const HeatSums sums = sum_conducting(grid, i, xi, [&](std::uint32_t j) {
+                    std::uint32_t read = 0;
+                    return HeatSums{heat_pair(xi, k_i, gamma_i, j, solid_end, position, particle, kernel, read), Real(0)};
+                });
+                return two_s * particle[i].volume / particle[i].capacity * sums.weight;
             });
-            return two_s * particle[i].volume / particle[i].capacity * sums.weight;
-        });
         d_per_dt_ = double(largest);
     }
+
+    // Advances the temperatures by the step over the fluid [0, fluid_end), whose rows come from the
+    // step's neighbourhood, and the moving solids' particles [fluid_end, solid_end) (the grid). The
+    // sub-steps alternate between the store's field and other_, starting where an odd or even count
+    // ends in the store. Then the heat content (a reduction read back: the run's conservation check,
+    // stats.csv). Here, where the step's length is settled (PCISPH may have halved it) and nothing
+    // has moved yet.
+    void conduct(StepContext& step) {
+        // Without fluid the solids' volumes are the heat's own to compute.
+        if (solids_.active() && !volumes_.updated_every_step()) volumes_.update_moving(step.neighbors.grid, step.ranges);
+        const HeatMaterials m = materials();
+        const std::size_t fluid_end = step.ranges.fluid_end, solid_end = step.ranges.solid_end;
+        const int substeps = substeps_for(double(step.dt));
+        last_substeps_ = substeps;
+        if (solid_end == 0) return;
+        View<Real> temperature = temperature_->view();
+        describe_particles(solid_end, m, substeps % 2 == 1 ? View<const Real>(temperature) : View<const Real>{});
+        const Real a = static_cast<Real>(2 * lattice_scale_ * double(step.dt) / substeps);
+        // An odd count starts from the copy in other_, an even one from the store: the last lands there.
+        View<Real> in = substeps % 2 == 1 ? other_.view() : temperature;
+        View<Real> out = substeps % 2 == 1 ? temperature : other_.view();
+        const View<const Vec3> position = state_.store.position.cview();
+        for (int substep = 0; substep < substeps; ++substep) {
+            if (fluid_end > 0)
+                step.neighbors.visit([&](const auto& rows) {
+                    heat_substep(state_.device, rows, 0, fluid_end, solid_end, position, particle_.cview(), in, out,
+                                 a, state_.fluid.kernel);
+                });
+            if (solid_end > fluid_end)
+                heat_substep(state_.device, step.neighbors.grid, fluid_end, solid_end - fluid_end, solid_end, position,
+                             particle_.cview(), in, out, a, state_.fluid.kernel);
+            std::swap(in, out);
+        }
+        last_content_ = heat_content(state_.device, solid_end, particle_.cview(), temperature, m.latent);
+    }
+
     // The sub-steps a step of dt needs (g <= 1 each), and takes (at most max_substeps).
     int substeps_needed(double dt) const {
         const double n = std::ceil(d_per_dt_ * dt);
         return n < 1 ? 1 : n > 1e9 ? 1000000000 : static_cast<int>(n);
     }
     int substeps_for(double dt) const { return std::min(substeps_needed(dt), max_substeps_); }
-    int last_substeps() const { return last_substeps_; }
-    double last_content() const { return last_content_; }  // the heat after the last step, J
-    std::size_t bytes() const { return particle_.bytes() + other_.bytes() + solid_rest_volume_.bytes(); }
 
-    // Advances `temperature` (a store field) by dt over the fluid [0, fluid_end), whose rows come
-    // from `fluid_rows` (this step's lists, or the grid), and the moving solids' particles
-    // [fluid_end, solid_end) (the grid). The sub-steps alternate between the store's field and
-    // other_, starting where an odd or even count ends in the store. Then the heat content (a
-    // reduction read back: the run's conservation check, stats.csv).
-    template <class Neighbors, class Kernel>
-    void step(const Neighbors& fluid_rows, const GridView& grid, std::size_t fluid_end, std::size_t solid_end,
-                View<const Vec3> position, const HeatMaterials& m, View<Real> temperature, Real dt, Kernel kernel) {
-        const int substeps = substeps_for(double(dt));
-        last_substeps_ = substeps;
-        if (solid_end == 0) return;
-        describe_particles(solid_end, m, substeps % 2 == 1 ? View<const Real>(temperature) : View<const Real>{});
-        const Real a = static_cast<Real>(2 * lattice_scale_ * double(dt) / substeps);
-        // An odd count starts from the copy in other_, an even one from the store: the last lands there.
-        View<Real> in = substeps % 2 == 1 ? other_.view() : temperature;
-        View<Real> out = substeps % 2 == 1 ? temperature : other_.view();
-        for (int substep = 0; substep < substeps; ++substep) {
-            if (fluid_end > 0)
-                heat_substep(fluid_rows, 0, fluid_end, solid_end, position, particle_.cview(), in, out, a, kernel);
-            if (solid_end > fluid_end)
-                heat_substep(grid, fluid_end, solid_end - fluid_end, solid_end, position, particle_.cview(), in, out,
-                             a, kernel);
-            std::swap(in, out);
-        }
-        last_content_ = heat_content(solid_end, particle_.cview(), temperature, m.latent);
+    void report_columns(std::vector<std::string>& names) const override {
+        if (!active()) return;
+        names.push_back("heat_substeps");
+        names.push_back("heat_content");
+    }
+    // The heat content is in J with T in degrees C (any consistent unit).
+    void report(std::vector<double>& values) const override {
+        if (!active()) return;
+        values.push_back(last_substeps_);
+        values.push_back(last_content_);
+    }
+    void check(const StateArchive& in) const override {
+        if (active() && !in.has("store.temperature"))
+            throw InputError("checkpoint: it holds no temperatures, and this scene conducts heat (heat.enabled); it "
+                             "was written for another scene");
+    }
+    std::size_t bytes() const override {
+        return particle_.bytes() + other_.bytes() + solid_rest_volume_.bytes() + object_heat_.bytes();
     }
 
-    // Each conducting particle's volume, conductivity, heat capacity and γ for this step, and a
-    // copy of `temperature` (when given: an odd count of sub-steps starts from it) in other_. Public only because nvcc allows no device lambda in a
-    // private member function.
+    // Each conducting particle's volume, conductivity, heat capacity and gamma for this step, and a
+    // copy of `temperature` (when given: an odd count of sub-steps starts from it) in other_.
+    // Public only because nvcc allows no device lambda in a private member function.
     void describe_particles(std::size_t solid_end, const HeatMaterials& m, View<const Real> temperature) {
         const View<Real> other = other_.view();
         const View<HeatParticle> particle = particle_.view();
         const View<const Real> rest = solid_rest_volume_.cview();
         const bool copy = temperature.data() != nullptr;
-        parallel_for("heat_materials", solid_end, [=] MW_HD(std::size_t i) {
+        parallel_for(state_.device, "heat_materials", solid_end, [=] MW_HD(std::size_t i) {
             if (copy) other[i] = temperature[i];
             const bool fluid = m.type[i] == kFluid;
             const std::int32_t slot = fluid ? 0 : m.solid_slot[i];
@@ -258,14 +340,40 @@ class HeatConduction {
     }
 
    private:
+    // Where the stage finds each particle's material and volume.
+    HeatMaterials materials() const {
+        const ParticleStore& store = state_.store;
+        HeatMaterials m;
+        m.type = store.type.cview();
+        m.density = store.density.cview();
+        m.boundary_volume = volumes_.volumes();
+        m.fluid = HeatMaterial{state_.params.heat.fluid_diffusivity, state_.params.heat.fluid_capacity};
+        m.fluid_mass = state_.fluid.mass;
+        m.rest_density = state_.fluid.rest_density;
+        m.latent = latent_ ? latent_->cview() : View<const Real>{};
+        if (solids_.active()) {
+            m.solid_slot = solids_.solid_slot_view();
+            m.slot_object = solids_.slot_objects().data();
+            m.objects = object_heat_.view().data();
+            m.solid_slots = solids_.boundary_slot_count();
+        }
+        return m;
+    }
+
+    SimulationState<Kernel>& state_;
+    BoundaryVolumes<Kernel>& volumes_;
+    const SolidBodies& solids_;
+    DeviceArray<Real>* temperature_ = nullptr;  // store field, degrees C
+    DeviceArray<Real>* latent_ = nullptr;       // store field of the melting module, when an object melts
     int max_substeps_ = 1;
     double lattice_scale_ = 1;
-    double d_per_dt_ = 0;  // the largest g / Δt
+    double d_per_dt_ = 0;  // the largest g / dt
     int last_substeps_ = 0;
     double last_content_ = 0;
-    DeviceArray<HeatParticle> particle_;  // per moving particle, this step's
-    DeviceArray<Real> other_;             // the sub-steps' second buffer
-    DeviceArray<Real> solid_rest_volume_;  // per solid slot (IBPs, SBPs), its V⁰
+    DeviceArray<HeatParticle> particle_;   // per moving particle, this step's
+    DeviceArray<Real> other_;              // the sub-steps' second buffer
+    DeviceArray<Real> solid_rest_volume_;  // per solid slot (IBPs, SBPs), its V0
+    DeviceArray<HeatMaterial> object_heat_;  // per object of the setup, its thermal properties
 };
 
 MW_BACKEND_END

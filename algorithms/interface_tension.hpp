@@ -17,13 +17,16 @@
 #pragma once
 #include <cstdint>
 
-#include "algorithms/neighbor_grid.hpp"
+#include "algorithms/boundary_volumes.hpp"
+#include "algorithms/fluid.hpp"
+#include "algorithms/module.hpp"
 #include "algorithms/particle_types.hpp"
+#include "algorithms/solid_bodies.hpp"
 
 MW_BACKEND_BEGIN
 
 // What the tension reads: the moving solids' particles and each SBP's η.
-struct InterfaceTension {
+struct TensionData {
     View<const std::uint8_t> type;  // store fields
     View<const std::int32_t> solid_slot;
     const Real* sbp_eta = nullptr;  // η per SBP index; null: no tension anywhere
@@ -33,10 +36,10 @@ struct InterfaceTension {
 // a_i += Σ_s -η_s ψ_s W(x_is) x_is / |x_is| (F / m_i) over the SBPs around fluid particle i.
 // `accumulate`: add to what the viscosity stage wrote; otherwise start from gravity.
 template <class Kernel>
-void add_interface_tension(GridView grid, std::size_t fluid_count, View<const Vec3> position,
-                           View<const Real> boundary_volume, View<Vec3> acceleration, const InterfaceTension t,
+void add_interface_tension(const DeviceContext& device, GridView grid, std::size_t fluid_count, View<const Vec3> position,
+                           View<const Real> boundary_volume, View<Vec3> acceleration, const TensionData t,
                            Kernel kernel, Real rest_density, Vec3 gravity, bool accumulate) {
-    parallel_for("interface_tension", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "interface_tension", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i];
         Vec3 sum{0, 0, 0};
         grid.for_each_solid(xi, [&](std::uint32_t b) {
@@ -53,5 +56,45 @@ void add_interface_tension(GridView grid, std::size_t fluid_count, View<const Ve
         acceleration[i] = accumulate ? acceleration[i] + a : gravity + a;
     });
 }
+
+// The interface tension module (stage "interface_tension"): with fluid and an object whose
+// interface_tension is not 0. It adds to the fluid's non-pressure forces; its reaction on the
+// objects is the coupling's (coupling.hpp).
+template <class Kernel>
+class InterfaceTension final : public Module {
+   public:
+    InterfaceTension(SimulationState<Kernel>& state, const BoundaryVolumes<Kernel>& volumes, Fluid<Kernel>& fluid,
+                     const SolidBodies& solids)
+        : state_(state), volumes_(volumes), fluid_(fluid), solids_(solids),
+          active_(state.has_fluid && solids.active() && solids.has_tension()) {}
+
+    // Whether the scene needs it (the fluid then keeps a non-pressure field for it).
+    static bool needed(bool has_fluid, const SolidBodies& solids) {
+        return has_fluid && solids.active() && solids.has_tension();
+    }
+
+    void bind(StepPlan& plan) override {
+        if (active_) plan.bind("interface_tension", [this](StepContext& step) { apply(step); });
+    }
+
+    void apply(StepContext& step) {
+        TensionData t;
+        t.type = state_.store.type.cview();
+        t.solid_slot = solids_.solid_slot_view();
+        t.sbp_eta = solids_.sbp_eta();
+        t.ibp_count = static_cast<std::uint32_t>(solids_.ibp_count());
+        add_interface_tension(state_.device, step.neighbors.grid, step.ranges.fluid_end, state_.store.position.cview(),
+                              volumes_.volumes(), fluid_.nonpressure(), t, state_.fluid.kernel,
+                              state_.fluid.rest_density, state_.fluid.gravity, fluid_.has_viscosity());
+        step.nonpressure = fluid_.nonpressure().data();
+    }
+
+   private:
+    SimulationState<Kernel>& state_;
+    const BoundaryVolumes<Kernel>& volumes_;
+    Fluid<Kernel>& fluid_;
+    const SolidBodies& solids_;
+    bool active_ = false;
+};
 
 MW_BACKEND_END

@@ -18,6 +18,13 @@
 
 MW_BACKEND_BEGIN
 
+// The inner particles' kinetic energy, top speed and first non-finite slot after an LSM step.
+struct SolidSummary {
+    double kinetic_energy = 0;
+    Real max_speed2 = 0;
+    std::uint32_t first_bad = 0xffffffffu;  // slot of the first non-finite IBP
+};
+
 // Sums over members of one region, relative to its anchor (see the top of the file): su = Σ m̃ (u
 // - u_a), Au = Σ m̃ (u - u_a) qᵀ; for damped objects sv = Σ m̃ v and sl = Σ m̃ (x - c0) × v; for
 // objects whose forces act through the regions, sf = Σ f̃ and sτ = Σ (x - c0) × f̃, with f̃ = f / (the
@@ -131,19 +138,19 @@ MW_INLINE bool region_damped(const LsmData& d, std::uint32_t r) {
 // rigid velocity (linear velocity V and angular velocity ω = I⁻¹ L, with the rest inertia
 // rotated by R). A region of more than kRegionSerialMembers (a rigid body) would leave one thread
 // looping over all its members; it is summed in chunks first, in a fixed order (deterministic).
-inline void lsm_region_update(const LsmData d) {
+inline void lsm_region_update(const DeviceContext& device, const LsmData d) {
     // u = x - x0 once per IBP, in slot order: each is read by about (2w + 1)^3 regions.
-    parallel_for("lsm_displacements", d.ibp_count, [=] MW_HD(std::size_t s) {
+    parallel_for(device, "lsm_displacements", d.ibp_count, [=] MW_HD(std::size_t s) {
         const std::uint32_t i = d.store_of_slot[s];
         if (i != kMeltedSlot) d.displacement[s] = d.position[i] - d.rest[s];
     });
-    parallel_for("lsm_region_chunks", d.chunk_count, [=] MW_HD(std::size_t c) {
+    parallel_for(device, "lsm_region_chunks", d.chunk_count, [=] MW_HD(std::size_t c) {
         const std::uint32_t r = d.chunk_region[c];
         const std::uint32_t end = c + 1 < d.region_chunks[r + 1] ? d.chunk_begin[c + 1] : d.region_end[r];
         d.chunk_sums[c] = sum_region_members(d, d.chunk_begin[c], end, d.region_c0[r],
                                              region_anchor_displacement(d, r), region_damped(d, r), d.forces);
     });
-    parallel_for("lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
+    parallel_for(device, "lsm_regions", d.region_count, [=] MW_HD(std::size_t r) {
         const std::uint32_t begin = d.region_offsets[r], end = d.region_end[r];
         if (begin == end) return;  // a melted particle's
         const Real M = d.region_mass[r];
@@ -223,8 +230,8 @@ MW_INLINE Vec3 lsm_goal_offset(const LsmData& d, std::uint32_t s, Vec3 x, Vec3 v
 
 // The IBP update: v += α (g - x)/Δt + Δt (a_ext + gravity) (after damping), x += Δt v, then the
 // domain walls; pinned IBPs stay at their rest position with zero velocity.
-inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
-    parallel_for("lsm_update", d.ibp_count, [=] MW_HD(std::size_t si) {
+inline void lsm_particle_update(const DeviceContext& device, const LsmData d, const LsmStepParams p) {
+    parallel_for(device, "lsm_update", d.ibp_count, [=] MW_HD(std::size_t si) {
         const std::uint32_t s = static_cast<std::uint32_t>(si);
         const std::uint32_t i = d.store_of_slot[s];
         if (i == kMeltedSlot) return;  // now fluid (melting.hpp)
@@ -276,8 +283,8 @@ inline void lsm_particle_update(const LsmData d, const LsmStepParams p) {
 }
 
 // Goals without updating anything (tests): goal[s] = x_s + (g_s - x_s).
-inline void lsm_goals(const LsmData d, View<Vec3> goal) {
-    parallel_for("lsm_goals", d.ibp_count, [=] MW_HD(std::size_t si) {
+inline void lsm_goals(const DeviceContext& device, const LsmData d, View<Vec3> goal) {
+    parallel_for(device, "lsm_goals", d.ibp_count, [=] MW_HD(std::size_t si) {
         const std::uint32_t s = static_cast<std::uint32_t>(si);
         const std::uint32_t i = d.store_of_slot[s];
         if (i == kMeltedSlot) {

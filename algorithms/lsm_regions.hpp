@@ -26,9 +26,9 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "algorithms/vec3.hpp"
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

@@ -32,7 +32,7 @@
 #include "algorithms/lsm_regions.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "algorithms/solid_bodies.hpp"
 #include "backend/backend.hpp"
 #include "backend/reduce_ops.hpp"
@@ -60,8 +60,8 @@ struct MeltingData {
 
 // Per IBP slot of a melting object still in it: the latent-heat exchange at T_m, and whether the
 // particle melts now (see the top of the file).
-inline void exchange_latent_heat(std::size_t ibp_count, const MeltingData d) {
-    parallel_for("melting_latent_heat", ibp_count, [=] MW_HD(std::size_t s) {
+inline void exchange_latent_heat(const DeviceContext& device, std::size_t ibp_count, const MeltingData d) {
+    parallel_for(device, "melting_latent_heat", ibp_count, [=] MW_HD(std::size_t s) {
         d.melts[s] = 0;
         const std::uint32_t i = d.store_of_slot[s];
         if (i == kMeltedSlot) return;
@@ -97,9 +97,9 @@ struct PhaseChangeData {
     Real* density = nullptr;
     Real rest_density = 0;
 };
-inline void apply_phase_change(const PhaseChangeData d, View<const std::uint32_t> melted,
+inline void apply_phase_change(const DeviceContext& device, const PhaseChangeData d, View<const std::uint32_t> melted,
                                View<const std::uint32_t> exposed) {
-    parallel_for("melting_to_fluid", melted.size(), [=] MW_HD(std::size_t k) {
+    parallel_for(device, "melting_to_fluid", melted.size(), [=] MW_HD(std::size_t k) {
         const std::uint32_t s = melted[k];
         const std::uint32_t i = d.store_of_slot[s];
         d.type[i] = kFluid;
@@ -108,7 +108,7 @@ inline void apply_phase_change(const PhaseChangeData d, View<const std::uint32_t
         d.density[i] = d.rest_density;
         d.store_of_slot[s] = kMeltedSlot;
     });
-    parallel_for("melting_exposed", exposed.size(), [=] MW_HD(std::size_t k) {
+    parallel_for(device, "melting_exposed", exposed.size(), [=] MW_HD(std::size_t k) {
         d.type[d.store_of_slot[exposed[k]]] = kSurfaceBoundary;
     });
 }
@@ -119,12 +119,16 @@ struct PhaseChangeCounts {
     long exposed = 0;  // IBPs that became SBPs
 };
 
-// The stage: its buffers, and the host's record of which lattice vertices are left.
-class PhaseChange {
+// The melting module (stage "melting", with an object that has a melting_point): its buffers, and
+// the host's record of which lattice vertices are left.
+class PhaseChange final : public Module {
    public:
-    // `solids` initialised. Registers the store field `latent_heat` (K, 0 to start). Throws
-    // InputError for a melting object that is not elastic, or melting without heat conduction.
-    void init(const SimulationSetup& setup, ParticleStore& store, SolidBodies& solids) {
+    // `solids` initialised, and the heat's store field `temperature` registered. Registers the
+    // store field `latent_heat` (K, 0 to start). Throws InputError for a melting object that is not
+    // elastic, or melting without heat conduction.
+    PhaseChange(const DeviceContext& device, const SimulationSetup& setup, ParticleStore& store, SolidBodies& solids,
+                ParticleCounts& counts, Real rest_density)
+        : device_(device), store_(store), solids_(solids), counts_(counts), rest_density_(rest_density) {
         std::vector<MeltingPoint> points(setup.solids.size());
         bool any = false;
         for (std::size_t o = 0; o < setup.solids.size(); ++o) {
@@ -150,6 +154,8 @@ class PhaseChange {
             any = true;
         }
         if (!any) return;
+        temperature_ = store.find<Real>("temperature");
+        if (!temperature_) throw InputError("simulation setup: melting needs heat conduction");
         ibp_count_ = solids.ibp_count();
         points_.upload(points);
         latent_ = &store.add<Real>("latent_heat", FieldLife::kPersistent);
@@ -183,6 +189,25 @@ class PhaseChange {
     }
 
     bool active() const { return latent_ != nullptr; }
+
+    void bind(StepPlan& plan) override {
+        if (active()) plan.bind("melting", [this](StepContext&) { melt(); });
+    }
+    // Latent heat at the melting point, then the melting objects' SBPs that melt become fluid (the
+    // next step's sort moves them to the fluid's range), the IBPs they leave exposed become SBPs,
+    // and the regions are rebuilt.
+    void melt() {
+        const PhaseChangeCounts changed = step(store_, solids_, *temperature_, rest_density_);
+        counts_.by_type[kFluid] += changed.melted;
+        counts_.by_type[kSurfaceBoundary] += changed.exposed - changed.melted;
+        counts_.by_type[kInnerBoundary] -= changed.exposed;
+    }
+    void report_columns(std::vector<std::string>& names) const override {
+        if (active()) names.push_back("melted");
+    }
+    void report(std::vector<double>& values) const override {
+        if (active()) values.push_back(double(melted_total_));
+    }
     View<const Real> latent() const { return latent_ ? latent_->cview() : View<const Real>{}; }
     // Particles melted since the scene started.
     long melted_total() const { return melted_total_; }
@@ -200,7 +225,7 @@ class PhaseChange {
         d.temperature = temperature.view().data();
         d.latent = latent_->view().data();
         d.melts = melts_.view().data();
-        exchange_latent_heat(ibp_count_, d);
+        exchange_latent_heat(device_, ibp_count_, d);
         PhaseChangeCounts counts;
         if (count_melting() == 0) return counts;
         // Something melts: which (a copy to the host), who is exposed, the regions left.
@@ -243,7 +268,7 @@ class PhaseChange {
         p.object = store.object.view().data();
         p.density = store.density.view().data();
         p.rest_density = rest_density;
-        apply_phase_change(p, View<const std::uint32_t>{melted_.cview().data(), melted.size()},
+        apply_phase_change(device_, p, View<const std::uint32_t>{melted_.cview().data(), melted.size()},
                            View<const std::uint32_t>{exposed_.cview().data(), exposed.size()});
         solids.rebuild_melting_regions(alive_, &gone);
         counts.melted = long(melted.size());
@@ -255,6 +280,7 @@ class PhaseChange {
     // After a checkpoint's store has loaded: the slots left are those some particle still holds;
     // the regions are rebuilt over them and the others marked melted in the slot map (which the
     // next step's sort fills for the rest).
+    void load(const StateArchive&) override { load(store_, solids_); }
     void load(const ParticleStore& store, SolidBodies& solids) {
         if (!active()) return;
         const std::vector<std::int32_t> slot = solids.solid_slot_field().to_host();
@@ -274,17 +300,23 @@ class PhaseChange {
         solids.update_slot_map(store);
     }
 
-    std::size_t bytes() const { return points_.bytes() + melts_.bytes() + melted_.bytes() + exposed_.bytes(); }
+    std::size_t bytes() const override { return points_.bytes() + melts_.bytes() + melted_.bytes() + exposed_.bytes(); }
 
     // The number of slots flagged to melt this step (a reduction read back). Public only because
     // nvcc allows no device lambda in a private member function.
     long count_melting() {
         const std::uint8_t* melts = melts_.cview().data();
-        return long(transform_reduce("melting_count", ibp_count_, std::uint32_t(0), SumOp{},
+        return long(transform_reduce(device_, "melting_count", ibp_count_, std::uint32_t(0), SumOp{},
                                      [=] MW_HD(std::size_t s) { return std::uint32_t(melts[s]); }));
     }
 
    private:
+    const DeviceContext& device_;
+    ParticleStore& store_;
+    SolidBodies& solids_;
+    ParticleCounts& counts_;
+    Real rest_density_ = 0;
+    DeviceArray<Real>* temperature_ = nullptr;  // the heat's store field
     std::size_t ibp_count_ = 0;
     DeviceArray<MeltingPoint> points_;         // per object
     DeviceArray<Real>* latent_ = nullptr;      // store field: heat absorbed at T_m, K

@@ -11,7 +11,7 @@
 
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -213,6 +213,7 @@ struct GroupRanges {
 
 class NeighborGrid {
    public:
+    explicit NeighborGrid(const DeviceContext& device) : device_(device) {}
     // Fits a grid of cells of size h / cells_per_h over [lo, hi].
     void configure(Vec3 lo, Vec3 hi, Real h, CellOrdering ordering, int cells_per_h = 1) {
         shape_.reach = cells_per_h;
@@ -275,6 +276,7 @@ class NeighborGrid {
     }
 
    private:
+    const DeviceContext& device_;
     GridShape shape_;
     bool has_solids_ = false;  // set by build(): the solid group is non-empty
     DeviceArray<std::uint32_t> keys_, sorted_keys_, order_, sorted_order_;
@@ -298,11 +300,11 @@ MW_INLINE void group_and_cell(const GridShape& shape, Vec3 x, std::uint8_t type,
 
 // Fills `first`/`last` (indexed by group * cell_count + cell) from particles [0, n) already sorted
 // by key; `offset` is added to the stored indices. Also records where each group starts.
-inline void fill_cell_ranges(const GridShape& shape, View<const Vec3> position, View<const std::uint8_t> type,
+inline void fill_cell_ranges(const DeviceContext& device, const GridShape& shape, View<const Vec3> position, View<const std::uint8_t> type,
                              bool use_groups, std::size_t n, std::size_t offset, std::uint32_t* first,
                              std::uint32_t* last, std::uint32_t* group_first) {
     const std::uint32_t cell_count = shape.cell_count;
-    parallel_for("grid_cell_ranges", n, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "grid_cell_ranges", n, [=] MW_HD(std::size_t i) {
         std::uint32_t g, cell;
         group_and_cell(shape, position[i], type[i], use_groups, g, cell);
         bool starts = i == 0, ends = i + 1 == n;
@@ -337,7 +339,7 @@ inline void NeighborGrid::build_static(ParticleStore& store) {
     View<std::uint32_t> keys = keys_.view(), order = order_.view();
     group_first_.assign(kGroupCount, 0);
     std::uint32_t* outside = group_first_.view().data();
-    parallel_for("grid_static_keys", n, [=] MW_HD(std::size_t i) {
+    parallel_for(device_, "grid_static_keys", n, [=] MW_HD(std::size_t i) {
         int c[3] = {0, 0, 0};
         order[i] = static_cast<std::uint32_t>(i);
         if (shape.cell_of(position[i], c)) {
@@ -353,13 +355,13 @@ inline void NeighborGrid::build_static(ParticleStore& store) {
         throw InputError(std::to_string(outside_count) +
                          " static boundary particles lie outside the simulation grid (move the static boxes "
                          "inside the domain)");
-    sort_pairs("grid_static_sort", keys_.cview(), sorted_keys_.view(), order_.cview(), sorted_order_.view(),
+    sort_pairs(device_, "grid_static_sort", keys_.cview(), sorted_keys_.view(), order_.cview(), sorted_order_.view(),
                shape.key_bits());
     store.permute(sorted_order_.cview(), first);
     static_begin_.assign(shape.cell_count, 0);  // once per static build; see configure()
     static_end_.assign(shape.cell_count, 0);
     View<const std::uint8_t> type{store.type.view().data() + first, n};
-    fill_cell_ranges(shape, position, type, false, n, first, static_begin_.view().data(), static_end_.view().data(),
+    fill_cell_ranges(device_, shape, position, type, false, n, first, static_begin_.view().data(), static_end_.view().data(),
                      nullptr);
 }
 
@@ -375,7 +377,7 @@ inline GroupRanges NeighborGrid::build(ParticleStore& store) {
     View<const Vec3> position = store.position.cview();
     View<const std::uint8_t> type = store.type.cview();
     View<std::uint32_t> keys = keys_.view(), order = order_.view();
-    parallel_for("grid_keys", n, [=] MW_HD(std::size_t i) {
+    parallel_for(device_, "grid_keys", n, [=] MW_HD(std::size_t i) {
         int c[3] = {0, 0, 0};
         std::uint32_t group = neighbor_group(type[i]);
         if (!shape.cell_of(position[i], c)) {
@@ -385,14 +387,14 @@ inline GroupRanges NeighborGrid::build(ParticleStore& store) {
         keys[i] = shape.sort_key(group, c);
         order[i] = static_cast<std::uint32_t>(i);
     });
-    sort_pairs("grid_sort", keys_.cview(), sorted_keys_.view(), order_.cview(), sorted_order_.view(),
+    sort_pairs(device_, "grid_sort", keys_.cview(), sorted_keys_.view(), order_.cview(), sorted_order_.view(),
                shape.key_bits());
     store.permute(sorted_order_.cview(), 0);
     // Only the ends are cleared: an empty cell has end 0, so [begin, end) is empty whatever stale
     // begin it holds, and every non-empty cell gets both written below.
     end_.fill(0);
     group_first_.assign(kGroupCount, static_cast<std::uint32_t>(n));
-    fill_cell_ranges(shape, View<const Vec3>{position.data(), n}, View<const std::uint8_t>{type.data(), n}, true, n, 0,
+    fill_cell_ranges(device_, shape, View<const Vec3>{position.data(), n}, View<const std::uint8_t>{type.data(), n}, true, n, 0,
                      begin_.view().data(), end_.view().data(), group_first_.view().data());
     std::uint32_t group_first[kGroupCount];
     group_first_.download_range(group_first, 0, kGroupCount);  // the one host copy of the build

@@ -17,7 +17,7 @@
 #include <string>
 
 #include "algorithms/neighbor_grid.hpp"
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -63,6 +63,8 @@ class NeighborList {
     // a second fill (measured): slack 4: 643 of 1000 (6,859-particle block), 152 of 250 (59,319),
     // 1169 of 1209 (default dam break, CFL steps); slack 8: 3, 4, 439; slack 16: 1, 1, 27.
     static constexpr std::uint32_t kRowSlack = 16;
+
+    explicit NeighborList(const DeviceContext& device) : device_(device) {}
 
     // Lists for fluid particles [0, fluid_count) within `radius` of their current positions.
     // row_counts[i] is i's count from the last build (0 before the first) and receives the new
@@ -115,6 +117,7 @@ class NeighborList {
                                 Real radius, View<std::uint32_t> row_counts);
 
    private:
+    const DeviceContext& device_;
     DeviceArray<std::uint32_t> offsets_, boundary_begin_, indices_;
     const std::uint32_t* row_counts_ = nullptr;
     long second_fills_ = 0;
@@ -129,10 +132,10 @@ inline void NeighborList::lay_out_rows(std::size_t fluid_count, View<const std::
     // Row sizes, and a 0 after the last, so that the in-place scan leaves the total in
     // offsets[fluid_count] without an upload.
     View<std::uint32_t> offsets = offsets_.view();
-    parallel_for("neighbor_list_row_sizes", fluid_count + 1, [=] MW_HD(std::size_t i) {
+    parallel_for(device_, "neighbor_list_row_sizes", fluid_count + 1, [=] MW_HD(std::size_t i) {
         offsets[i] = i < fluid_count ? row_counts[i] + kRowSlack : 0u;
     });
-    const std::size_t total = exclusive_scan("neighbor_list_offsets", offsets_.cview(), offsets);
+    const std::size_t total = exclusive_scan(device_, "neighbor_list_offsets", offsets_.cview(), offsets);
     // Lists grow as a flow spreads along walls or compresses; a quarter of headroom keeps the
     // reallocation (and its first-touch page faults) out of almost every step.
     if (total > indices_.capacity()) indices_.resize(total + total / 4 + 1);
@@ -149,7 +152,7 @@ inline ListFillSummary NeighborList::fill(const GridView& grid, std::size_t flui
     // took 2.7 times as long as a counting pass, without one 1.6 times): every candidate is
     // written, the cursor advances only for those in range. Past the row's last slot, writes go
     // to a local dummy, so they never touch the next row, which another thread may be filling.
-    parallel_for("neighbor_list_fill", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device_, "neighbor_list_fill", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i];
         const std::uint32_t first = offsets[i], last = offsets[i + 1];
         std::uint32_t k = first;
@@ -166,7 +169,7 @@ inline ListFillSummary NeighborList::fill(const GridView& grid, std::size_t flui
         row_counts[i] = k - first;
     });
     View<const std::uint32_t> counts = row_counts;
-    return transform_reduce("neighbor_list_overflow", fluid_count, ListFillSummary{}, SumOp{},
+    return transform_reduce(device_, "neighbor_list_overflow", fluid_count, ListFillSummary{}, SumOp{},
                             [=] MW_HD(std::size_t i) {
                                 return ListFillSummary{std::uint64_t(offsets[i] + counts[i] > offsets[i + 1]),
                                                        std::uint64_t(counts[i]) + kRowSlack};
@@ -178,7 +181,7 @@ inline void NeighborList::build(const GridView& grid, std::size_t fluid_count, V
     row_counts_ = row_counts.data();
     if (fluid_count != last_fluid_count_) {
         View<const std::uint32_t> counts = row_counts;
-        next_layout_slots_ = transform_reduce("neighbor_list_slots", fluid_count, std::uint64_t(0), SumOp{},
+        next_layout_slots_ = transform_reduce(device_, "neighbor_list_slots", fluid_count, std::uint64_t(0), SumOp{},
                                               [=] MW_HD(std::size_t i) { return std::uint64_t(counts[i]) + kRowSlack; });
         last_fluid_count_ = fluid_count;
     }

@@ -28,6 +28,10 @@ struct FluidConstants {
     WallMirrors mirrors;      // the domain's free-slip walls, for Eq. 4 next to them
 };
 
+// How a step's PCISPH iterations ended: below the tolerance; diverged (the error rose to twice the
+// lowest it reached, fluid.hpp); or out of iterations above the tolerance.
+enum class PcisphOutcome { kConverged, kDiverged, kOutOfIterations };
+
 struct DensityError {
     double sum = 0;   // Σ max(ρ - ρ0, 0) / ρ0
     Real max = 0;
@@ -37,25 +41,6 @@ struct DensityErrorOp {
         return DensityError{a.sum + b.sum, a.max < b.max ? b.max : a.max};
     }
 };
-
-// Akinci boundary volume V_b = 1 / Σ_k W(x_b - x_k) over boundary neighbours k (b included), for
-// particles [first, first + count). Static particles see static neighbours only (computed once);
-// moving solids see moving solids and static walls. Branch-free terms (W_r2 is 0 out of range by
-// itself), as in the PCISPH sums: a boundary particle's neighbourhood is dense (walls at r0/2), and
-// whether a candidate is in range is unpredictable.
-template <class Kernel>
-void compute_boundary_volumes(GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
-                              std::size_t count, bool moving, Kernel kernel) {
-    parallel_for("boundary_volume", count, [=] MW_HD(std::size_t k) {
-        const std::size_t b = first + k;
-        const Vec3 xb = position[b];
-        Real sum = 0;
-        auto add = [&](std::uint32_t j) { sum += kernel.W_r2(norm2(xb - position[j])); };
-        grid.for_each_static(xb, add);
-        if (moving) grid.for_each_solid(xb, add);
-        volume[b] = sum > Real(0) ? Real(1) / sum : Real(0);
-    });
-}
 
 // Non-pressure acceleration of fluid: gravity, viscosity (the paper's Eq. 4 with the Müller
 // viscosity Laplacian, which is never negative) and friction against boundary particles (Eq. 8,
@@ -69,13 +54,13 @@ void compute_boundary_volumes(GridView grid, View<const Vec3> position, View<Rea
 // of range and for i itself (v_i - v_i), so no test is needed. (i's own image is not 0: it brakes
 // i's velocity into the wall, which the fluid pairs cannot see when all move alike.)
 template <class Neighbors, class Kernel>
-void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> position,
+void compute_viscosity_acceleration(const DeviceContext& device, Neighbors neighbors, std::size_t fluid_count, View<const Vec3> position,
                                     View<const Vec3> velocity, View<const Real> density,
                                     View<const Real> boundary_volume, View<Vec3> acceleration,
                                     FluidConstants<Kernel> c) {
     const bool friction = c.wall_viscosity > Real(0);
     const Real h2 = c.kernel.h * c.kernel.h;
-    parallel_for("viscosity", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "viscosity", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = position[i], vi = velocity[i];
         Vec3 fluid_sum = neighbors.sum_fluid(i, xi, [&](std::uint32_t j) {
             return (c.kernel.laplacian_visc_r2(norm2(xi - position[j])) / density[j]) * (velocity[j] - vi);
@@ -104,10 +89,10 @@ void compute_viscosity_acceleration(Neighbors neighbors, std::size_t fluid_count
 // velocity–position correction: against moving solids' SBPs where it is on (virtual_boundary.hpp),
 // then against the walls (wall_contact.hpp). Without a non-pressure field, a_np is gravity.
 // A null pressure_acc means no pressure acceleration yet.
-inline void predict_positions(std::size_t fluid_count, View<const Vec3> position, View<const Vec3> velocity,
+inline void predict_positions(const DeviceContext& device, std::size_t fluid_count, View<const Vec3> position, View<const Vec3> velocity,
                               const Vec3* nonpressure, const Vec3* pressure_acc, View<Vec3> predicted, Vec3 gravity,
                               Real dt, WallContact walls, SolidSurface solids = SolidSurface{}) {
-    parallel_for("pcisph_predict", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "pcisph_predict", fluid_count, [=] MW_HD(std::size_t i) {
         Vec3 a = nonpressure ? nonpressure[i] : gravity;
         if (pressure_acc) a += pressure_acc[i];
         const Vec3 v = velocity[i] + dt * a;
@@ -148,12 +133,12 @@ struct SolidLookahead {
 // The first iteration of a step starts from p = 0 (so no separate pass clears the pressure).
 // Moving solids' boundary particles are met where `lookahead` puts them, static ones where they are.
 template <class Neighbors, class Kernel>
-void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
+void predict_density_and_pressure(const DeviceContext& device, Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
                                   View<const Vec3> position, SolidLookahead lookahead,
                                   View<const Real> boundary_volume, View<Real> density, View<Real> pressure,
                                   View<Real> pressure_term, FluidConstants<Kernel> c, Real delta,
                                   bool first_iteration) {
-    parallel_for("pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "pcisph_density", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         const Real fluid_sum = neighbors.sum_fluid(i, position[i], [&](std::uint32_t j) {
             return c.kernel.W_r2(norm2(xi - predicted[j]));
@@ -170,9 +155,9 @@ void predict_density_and_pressure(Neighbors neighbors, std::size_t fluid_count, 
     });
 }
 
-inline DensityError density_error(std::size_t fluid_count, View<const Real> density, Real rest_density) {
+inline DensityError density_error(const DeviceContext& device, std::size_t fluid_count, View<const Real> density, Real rest_density) {
     const Real inv_rest = Real(1) / rest_density;
-    return transform_reduce("pcisph_density_error", fluid_count, DensityError{}, DensityErrorOp{},
+    return transform_reduce(device, "pcisph_density_error", fluid_count, DensityError{}, DensityErrorOp{},
                             [=] MW_HD(std::size_t i) {
                                 const Real e = (density[i] - rest_density) * inv_rest;
                                 const Real compression = e > Real(0) ? e : Real(0);
@@ -182,10 +167,10 @@ inline DensityError density_error(std::size_t fluid_count, View<const Real> dens
 
 // a_p,i = -m Σ_j (p_i/ρ_i² + p_j/ρ_j²) ∇W(x*_ij) - Σ_b ψ_b (p_i/ρ_i²) ∇W(x*_i - x_b).
 template <class Neighbors, class Kernel>
-void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
+void pressure_acceleration(const DeviceContext& device, Neighbors neighbors, std::size_t fluid_count, View<const Vec3> predicted,
                            View<const Vec3> position, SolidLookahead lookahead, View<const Real> boundary_volume,
                            View<const Real> pressure_term, View<Vec3> pressure_acc, FluidConstants<Kernel> c) {
-    parallel_for("pcisph_pressure_force", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "pcisph_pressure_force", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 xi = predicted[i];
         const Real pi_rho2 = pressure_term[i];
         // Out-of-range pairs and i itself contribute a zero gradient, so no test is needed.
@@ -203,9 +188,9 @@ void pressure_acceleration(Neighbors neighbors, std::size_t fluid_count, View<co
 
 // Symplectic Euler: v += Δt (a_np + a_p); x += Δt v; then the velocity–position correction
 // against the domain walls, the static boxes and static objects (wall_contact.hpp).
-inline void integrate_fluid(std::size_t fluid_count, View<Vec3> position, View<Vec3> velocity, const Vec3* nonpressure,
+inline void integrate_fluid(const DeviceContext& device, std::size_t fluid_count, View<Vec3> position, View<Vec3> velocity, const Vec3* nonpressure,
                             View<const Vec3> pressure_acc, Vec3 gravity, Real dt, WallContact walls) {
-    parallel_for("integrate_fluid", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "integrate_fluid", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 a = (nonpressure ? nonpressure[i] : gravity) + pressure_acc[i];
         Vec3 v = velocity[i] + dt * a;
         Vec3 x = position[i] + dt * v;
@@ -235,8 +220,8 @@ MW_INLINE MotionSummary particle_motion(Vec3 x, Vec3 v, Real mass, std::uint32_t
     return MotionSummary{finite ? 0.5 * double(mass) * double(v2) : 0.0, finite ? v2 : Real(0),
                          finite ? 0xffffffffu : index};
 }
-inline MotionSummary summarize_motion(std::size_t count, View<const Vec3> position, View<const Vec3> velocity, Real mass) {
-    return transform_reduce("motion_summary", count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
+inline MotionSummary summarize_motion(const DeviceContext& device, std::size_t count, View<const Vec3> position, View<const Vec3> velocity, Real mass) {
+    return transform_reduce(device, "motion_summary", count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
         return particle_motion(position[i], velocity[i], mass, static_cast<std::uint32_t>(i));
     });
 }

@@ -14,9 +14,8 @@
 #include <vector>
 
 #include "algorithms/coupling.hpp"
-#include "algorithms/heat.hpp"
-#include "algorithms/interface_tension.hpp"
 #include "algorithms/lsm.hpp"
+#include "algorithms/module.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
 #include "algorithms/pcisph.hpp"
@@ -26,22 +25,16 @@
 
 MW_BACKEND_BEGIN
 
-struct SolidSummary {
-    double kinetic_energy = 0;
-    Real max_speed2 = 0;
-    std::uint32_t first_bad = 0xffffffffu;  // slot of the first non-finite IBP
-};
-
 // Rebuilds store_of_slot from the store's solid_slot field (particles [0, count)).
-inline void build_slot_map(std::size_t count, View<const std::int32_t> solid_slot, View<std::uint32_t> store_of_slot) {
-    parallel_for("solid_slot_map", count, [=] MW_HD(std::size_t i) {
+inline void build_slot_map(const DeviceContext& device, std::size_t count, View<const std::int32_t> solid_slot, View<std::uint32_t> store_of_slot) {
+    parallel_for(device, "solid_slot_map", count, [=] MW_HD(std::size_t i) {
         const std::int32_t s = solid_slot[i];
         if (s >= 0) store_of_slot[static_cast<std::size_t>(s)] = static_cast<std::uint32_t>(i);
     });
 }
 
-inline SolidSummary summarize_solids(const LsmData d) {
-    const MotionSummary m = transform_reduce(
+inline SolidSummary summarize_solids(const DeviceContext& device, const LsmData d) {
+    const MotionSummary m = transform_reduce(device,
         "solid_summary", d.ibp_count, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t s) {
             const std::uint32_t i = d.store_of_slot[s];
             if (i == kMeltedSlot) return MotionSummary{};  // now fluid (melting.hpp)
@@ -50,8 +43,10 @@ inline SolidSummary summarize_solids(const LsmData d) {
     return SolidSummary{m.kinetic_energy, m.max_speed2, m.first_bad};
 }
 
-class SolidBodies {
+class SolidBodies final : public Module {
    public:
+    explicit SolidBodies(const DeviceContext& device) : device_(device) {}
+
     // Registers the slot field in `store` (already sized and filled in the order `order`, the
     // scene index of each store entry) and uploads the layout built from `setup`. Regions of more
     // than `serial_limit` members are summed in chunks (tests lower or raise it).
@@ -144,13 +139,6 @@ class SolidBodies {
             any_tension = any_tension || sbp_eta[k] > Real(0);
         }
         if (any_tension) sbp_eta_.upload(sbp_eta);
-        // Heat conduction (heat.hpp): each object's thermal diffusivity and heat capacity.
-        if (setup.params.heat.enabled) {
-            std::vector<HeatMaterial> materials;
-            for (const SolidSetup& solid : setup.solids)
-                materials.push_back(HeatMaterial{solid.thermal_diffusivity, solid.heat_capacity});
-            object_heat_.upload(materials);
-        }
         // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
         // forces act through the regions (lsm.hpp, LsmData::forces).
         // A melting object makes fluid of its own (melting.hpp), and an emitter brings some
@@ -221,6 +209,9 @@ class SolidBodies {
     void slot_map_fill(std::uint32_t value) { store_of_slot_.fill(value); }
     View<const std::int32_t> slot_objects() const { return object_.cview(); }
     DeviceArray<std::int32_t>& solid_slot_field() { return *solid_slot_; }
+    View<const std::int32_t> solid_slot_view() const { return solid_slot_ ? solid_slot_->cview() : View<const std::int32_t>{}; }
+    // The slots of the particles that meet the fluid: the IBPs, then the SBPs.
+    std::size_t boundary_slot_count() const { return ibp_count_ + sbp_count_; }
 
     bool active() const { return ibp_count_ > 0; }
     // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.
@@ -231,22 +222,46 @@ class SolidBodies {
 
     // After the neighbour sort: slot -> store index.
     void update_slot_map(const ParticleStore& store) {
-        build_slot_map(store.moving_count(), solid_slot_->cview(), store_of_slot_.view());
+        build_slot_map(device_, store.moving_count(), solid_slot_->cview(), store_of_slot_.view());
+    }
+
+    // The module's stages, over `store` (init's): where PCISPH meets the solids (`predicted`:
+    // where the step will take them, coupling.predict_solids; otherwise where they start it), and
+    // one LSM step under `gravity` inside the domain box. The slot map must be current (the
+    // simulation rebuilds it after every sort).
+    void plan(ParticleStore& store, Vec3 gravity, Vec3 domain_min, Vec3 domain_max, bool predicted) {
+        store_ = &store;
+        gravity_ = gravity;
+        domain_min_ = domain_min;
+        domain_max_ = domain_max;
+        predicts_ = predicted && active();
+    }
+    void bind(StepPlan& plan) override {
+        if (!active()) return;
+        if (predicts_)
+            plan.bind("solid_volumes", [this](StepContext& step) { step.lookahead = lookahead(*store_, step.ranges.solid_end); });
+        plan.bind("lsm", [this](StepContext& step) {
+            step.solid_motion = this->step(*store_, step.dt, gravity_, domain_min_, domain_max_);
+        });
+    }
+    // The summary's reduction makes its workspace on first use: once here, before the first step.
+    void start(const StepContext&) override {
+        if (active()) summary(*store_);
     }
 
     // One LSM step (the slot map must be current): regions, IBP update, GPs, SBPs.
     SolidSummary step(ParticleStore& store, Real dt, Vec3 gravity, Vec3 domain_min, Vec3 domain_max) {
         const LsmData d = data(store);
-        lsm_region_update(d);
+        lsm_region_update(device_, d);
         LsmStepParams p;
         p.dt = dt;
         p.gravity = gravity;
         p.domain_min = domain_min;
         p.domain_max = domain_max;
-        lsm_particle_update(d, p);
+        lsm_particle_update(device_, d, p);
         const InterpolationData g = interpolation(store);
-        interpolate_geometry(g, dt);
-        interpolate_surface(g);
+        interpolate_geometry(device_, g, dt);
+        interpolate_surface(device_, g);
         return summary(store);
     }
 
@@ -260,7 +275,7 @@ class SolidBodies {
         const std::uint32_t* begin = object_ibp_begin_.view().data();
         const Real* mass = mass_.view().data();
         Vec3* mean = object_velocity_.view().data();
-        parallel_for("solid_object_velocity", object_count_, [=] MW_HD(std::size_t o) {
+        parallel_for(device_, "solid_object_velocity", object_count_, [=] MW_HD(std::size_t o) {
             Vec3 momentum{0, 0, 0};
             Real total = 0;
             for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
@@ -281,16 +296,16 @@ class SolidBodies {
     }
 
     // The IBPs' kinetic energy, top speed and first non-finite slot (a reduction read back).
-    SolidSummary summary(ParticleStore& store) { return summarize_solids(data(store)); }
+    SolidSummary summary(ParticleStore& store) { return summarize_solids(device_, data(store)); }
 
     // The current goal of every IBP (slot order), without changing anything but the warm-start
     // rotations (tests).
     std::vector<Vec3> goals(ParticleStore& store) {
         update_slot_map(store);
         const LsmData d = data(store);
-        lsm_region_update(d);
+        lsm_region_update(device_, d);
         DeviceArray<Vec3> goal(ibp_count_);
-        lsm_goals(d, goal.view());
+        lsm_goals(device_, d, goal.view());
         return goal.to_host();
     }
 
@@ -350,25 +365,10 @@ class SolidBodies {
     // Whether the correction exchanges momentum with the solids (two-way coupling and the
     // correction on).
     bool contact_takes_impulses() const { return !sbp_impulse_.empty(); }
-    // Interface tension (interface_tension.hpp): whether any object has it, and what its kernel reads.
+    // Interface tension (interface_tension.hpp): whether any object has it, and its eta per SBP.
     bool has_tension() const { return !sbp_eta_.empty(); }
-    InterfaceTension tension(const ParticleStore& store) const {
-        InterfaceTension t;
-        t.type = store.type.cview();
-        t.solid_slot = solid_slot_->cview();
-        t.sbp_eta = sbp_eta_.empty() ? nullptr : sbp_eta_.view().data();
-        t.ibp_count = static_cast<std::uint32_t>(ibp_count_);
-        return t;
-    }
+    const Real* sbp_eta() const { return sbp_eta_.empty() ? nullptr : sbp_eta_.view().data(); }
 
-    // Heat conduction (heat.hpp): how the stage finds a solid particle's material.
-    void describe_heat(HeatMaterials& m) const {
-        if (!active()) return;
-        m.solid_slot = solid_slot_->cview();
-        m.slot_object = object_.view().data();
-        m.objects = object_heat_.view().data();
-        m.solid_slots = ibp_count_ + sbp_count_;
-    }
 
     // The force on each object's IBPs in the last step (N, summed in double on the host),
     // indexed like SimulationSetup::solids; static objects and uncoupled runs give 0. A copy to
@@ -393,17 +393,17 @@ class SolidBodies {
     // left for the next step's coupling, and the per-step arrays that are cheap to keep (so that
     // no read-before-write of one can make a resumed run differ). A solid particle's slot travels
     // with the store's fields.
-    void save(StateArchive& archive) const {
+    void save(StateArchive& archive) const override {
         for_each_state_array(*this, [&](const char* name, const auto& array) { archive.put(name, array.to_host()); });
     }
-    void load(const StateArchive& archive) {
+    void load(const StateArchive& archive) override {
         for_each_state_array(*this, [&](const char* name, auto& array) {
             using T = typename std::decay_t<decltype(array.to_host())>::value_type;
             array.upload(archive.get_sized<T>(name, array.size()));
         });
     }
 
-    std::size_t bytes() const {
+    std::size_t bytes() const override {
         return store_of_slot_.bytes() + rest_.bytes() + mass_.bytes() + split_mass_.bytes() + object_.bytes() +
                pinned_.bytes() + regions_begin_.bytes() + regions_end_.bytes() + force_.bytes() + displacement_.bytes() +
                mean_rotation_.bytes() + region_offsets_.bytes() + region_end_.bytes() + member_index_.bytes() + region_mass_.bytes() +
@@ -415,7 +415,7 @@ class SolidBodies {
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
-               object_ibp_begin_.bytes() + object_velocity_.bytes() + object_heat_.bytes();
+               object_ibp_begin_.bytes() + object_velocity_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -512,6 +512,10 @@ class SolidBodies {
         return total;
     }
 
+    const DeviceContext& device_;
+    ParticleStore* store_ = nullptr;  // plan()'s
+    Vec3 gravity_{0, 0, 0}, domain_min_{0, 0, 0}, domain_max_{0, 0, 0};
+    bool predicts_ = false;
     std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0, object_count_ = 0;
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;
@@ -551,7 +555,6 @@ class SolidBodies {
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
     DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
-    DeviceArray<HeatMaterial> object_heat_;        // per object, its thermal properties (heat conduction only)
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
     std::vector<MeltingLattice> melting_;   // host: the melting objects' lattices
     LsmHostLayout host_layout_;             // host: the layout, kept only when an object melts

@@ -82,10 +82,10 @@ struct SolidContactData {
 // two-way coupling J / Σ w for the SBPs' gather. The walls' correction follows a corrected
 // particle, as it does the integration (a particle pushed out of a solid must not end up beyond
 // a wall's layer).
-inline void correct_fluid_at_solids(std::size_t fluid_count, View<const Vec3> position,
+inline void correct_fluid_at_solids(const DeviceContext& device, std::size_t fluid_count, View<const Vec3> position,
                                     View<const Vec3> velocity, View<Vec3> out_position, View<Vec3> out_velocity,
                                     const SolidContactData d, const WallContact walls) {
-    parallel_for("solid_contact_fluid", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "solid_contact_fluid", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 x = position[i], v = velocity[i];
         const VirtualBoundary k = d.surface.collide(static_cast<std::uint32_t>(i), x, position, velocity,
                                                     d.sbp_inverse_mass);
@@ -112,9 +112,9 @@ inline void correct_fluid_at_solids(std::size_t fluid_count, View<const Vec3> po
 
 // Per SBP (two-way): its shares of the impulses of the fluid particles that collided with the
 // virtual particles it is part of, from the fluid's positions before the correction.
-inline void gather_sbp_impulses(std::size_t fluid_end, std::size_t solid_end, View<const Vec3> position,
+inline void gather_sbp_impulses(const DeviceContext& device, std::size_t fluid_end, std::size_t solid_end, View<const Vec3> position,
                                 const SolidContactData d) {
-    parallel_for("solid_contact_sbp", d.surface.sbp_count, [=] MW_HD(std::size_t k) {
+    parallel_for(device, "solid_contact_sbp", d.surface.sbp_count, [=] MW_HD(std::size_t k) {
         const SolidSurface& surface = d.surface;
         const std::uint32_t b = d.store_of_slot[surface.ibp_count + k];
         Vec3 sum{0, 0, 0};
@@ -130,9 +130,9 @@ inline void gather_sbp_impulses(std::size_t fluid_end, std::size_t solid_end, Vi
 }
 
 // Two-way: the corrected fluid back into the store.
-inline void apply_fluid_correction(std::size_t fluid_count, View<const Vec3> corrected_position,
+inline void apply_fluid_correction(const DeviceContext& device, std::size_t fluid_count, View<const Vec3> corrected_position,
                                    View<const Vec3> corrected_velocity, View<Vec3> position, View<Vec3> velocity) {
-    parallel_for("solid_contact_apply", fluid_count, [=] MW_HD(std::size_t i) {
+    parallel_for(device, "solid_contact_apply", fluid_count, [=] MW_HD(std::size_t i) {
         position[i] = corrected_position[i];
         velocity[i] = corrected_velocity[i];
     });

@@ -30,9 +30,9 @@ struct InterpolationData {
     Vec3* sbp_normal = nullptr;
 };
 
-inline void interpolate_geometry(const InterpolationData d, Real dt) {
+inline void interpolate_geometry(const DeviceContext& device, const InterpolationData d, Real dt) {
     const Real inv_dt = Real(1) / dt;
-    parallel_for("solid_gp", d.gp_count, [=] MW_HD(std::size_t g) {
+    parallel_for(device, "solid_gp", d.gp_count, [=] MW_HD(std::size_t g) {
         const Vec3 x0 = d.gp_rest[g];
         Vec3 x{0, 0, 0};
         for (std::uint32_t k = d.gp_offsets[g]; k < d.gp_offsets[g + 1]; ++k) {
@@ -45,8 +45,8 @@ inline void interpolate_geometry(const InterpolationData d, Real dt) {
     });
 }
 
-inline void interpolate_surface(const InterpolationData d) {
-    parallel_for("solid_sbp", d.sbp_count, [=] MW_HD(std::size_t k) {
+inline void interpolate_surface(const DeviceContext& device, const InterpolationData d) {
+    parallel_for(device, "solid_sbp", d.sbp_count, [=] MW_HD(std::size_t k) {
         const SbpLink link = d.sbp[k];
         Vec3 c[3], x{0, 0, 0}, v{0, 0, 0};
         const Real b[3] = {link.bary.x, link.bary.y, link.bary.z};

@@ -12,7 +12,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

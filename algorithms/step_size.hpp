@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "algorithms/state_archive.hpp"
 
 namespace mw {

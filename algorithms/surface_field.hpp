@@ -11,7 +11,10 @@
 #include <cmath>
 #include <cstdint>
 
-#include "algorithms/neighbor_grid.hpp"
+#include <vector>
+
+#include "algorithms/module.hpp"
+#include "algorithms/neighbor_search.hpp"
 #include "algorithms/pcisph_delta.hpp"
 
 MW_BACKEND_BEGIN
@@ -31,7 +34,7 @@ constexpr int kColorBlock = 4;
 // particles have left their lattice). The sums run in a fixed order (cells, then particles in
 // store order), so the field is reproducible on any thread count, and no node is written twice.
 template <class Kernel>
-void compute_color_field(const GridView& grid, View<const Vec3> position,
+void compute_color_field(const DeviceContext& device, const GridView& grid, View<const Vec3> position,
                          const Kernel& kernel, Real inverse_lattice_sum, const SurfaceNodes& nodes,
                          View<Real> color) {
     const int blocks[3] = {(nodes.dims[0] + kColorBlock - 1) / kColorBlock,
@@ -39,7 +42,7 @@ void compute_color_field(const GridView& grid, View<const Vec3> position,
                            (nodes.dims[2] + kColorBlock - 1) / kColorBlock};
     const std::size_t block_count = std::size_t(blocks[0]) * std::size_t(blocks[1]) * std::size_t(blocks[2]);
     const SurfaceNodes n = nodes;
-    parallel_for("surface_color_field", block_count, [=] MW_HD(std::size_t b) {
+    parallel_for(device, "surface_color_field", block_count, [=] MW_HD(std::size_t b) {
         const int bi = int(b % std::size_t(blocks[0])), bj = int((b / std::size_t(blocks[0])) % std::size_t(blocks[1])),
                   bk = int(b / (std::size_t(blocks[0]) * std::size_t(blocks[1])));
         const int lo[3] = {bi * kColorBlock, bj * kColorBlock, bk * kColorBlock};
@@ -127,3 +130,34 @@ double surface_iso_value(const Kernel& kernel, double spacing) {
 }
 
 }  // namespace mw
+
+MW_BACKEND_BEGIN
+
+// The surface field module: the colour field at frame times (no stage), and its nodes' buffer,
+// sized by the largest node box asked for so far.
+template <class Kernel>
+class SurfaceField final : public Module {
+   public:
+    SurfaceField(SimulationState<Kernel>& state, NeighborSearch<Kernel>& search) : state_(state), search_(search) {}
+
+    // The field at `nodes`, copied into `color`, and its iso-value. The particles have moved since
+    // this step's sort; a sort now (a stable sort by the keys the next step would compute) leaves
+    // the next step's sort nothing to reorder, so a run with surfaces takes the same steps.
+    void compute(const SurfaceNodes& nodes, std::vector<Real>& color, double& iso) {
+        search_.sort();
+        color_.resize(nodes.count());
+        // The mass is rho0 over the lattice's sum of W (pcisph_delta.hpp): m / rho0 normalises the field.
+        compute_color_field(state_.device, search_.grid(), state_.store.position.cview(), state_.fluid.kernel,
+                            state_.fluid.mass / state_.fluid.rest_density, nodes, color_.view());
+        color_.download(color);
+        iso = surface_iso_value(state_.fluid.kernel, double(state_.params.fluid.spacing));  // a few thousand kernel values
+    }
+    std::size_t bytes() const override { return color_.bytes(); }
+
+   private:
+    SimulationState<Kernel>& state_;
+    NeighborSearch<Kernel>& search_;
+    DeviceArray<Real> color_;
+};
+
+MW_BACKEND_END

@@ -147,8 +147,8 @@ struct SolidSurface {
 // Once a step, after the grid's build: which fluid particles have a moving solid's particle in
 // the cells around them (SolidSurface::fluid_near_solid). The same cells as every gather of the
 // step (the cells of the start of the step), so skipping the others changes no result.
-inline void mark_fluid_near_solids(std::size_t fluid_count, const GridView grid, View<std::uint8_t> near) {
-    parallel_for("solid_contact_near", fluid_count, [=] MW_HD(std::size_t i) {
+inline void mark_fluid_near_solids(const DeviceContext& device, std::size_t fluid_count, const GridView grid, View<std::uint8_t> near) {
+    parallel_for(device, "solid_contact_near", fluid_count, [=] MW_HD(std::size_t i) {
         near[i] = grid.has_solid_around_particle(static_cast<std::uint32_t>(i)) ? 1 : 0;
     });
 }

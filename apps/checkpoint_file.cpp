@@ -9,7 +9,7 @@
 
 #include "apps/atomic_file.hpp"
 #include "backend/config.hpp"
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

@@ -7,8 +7,8 @@
 #include <set>
 
 #include "apps/scene_builder.hpp"
-#include "backend/backend_registry.hpp"
-#include "backend/errors.hpp"
+#include "simulation/factory.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

@@ -7,7 +7,7 @@
 
 #include <cxxopts.hpp>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "apps/scene.hpp"
 
 namespace mw {

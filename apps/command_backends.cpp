@@ -3,7 +3,7 @@
 
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 
 namespace mw {
 

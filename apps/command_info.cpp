@@ -7,8 +7,8 @@
 #include "apps/commands.hpp"
 #include "apps/scene_builder.hpp"
 #include "apps/speed_limit.hpp"
-#include "backend/backend_registry.hpp"
-#include "backend/errors.hpp"
+#include "simulation/factory.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

@@ -15,8 +15,8 @@
 #include "apps/scene_builder.hpp"
 #include "apps/speed_limit.hpp"
 #include "apps/atomic_file.hpp"
-#include "backend/backend_registry.hpp"
-#include "backend/errors.hpp"
+#include "simulation/factory.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 
@@ -231,7 +231,7 @@ int command_run(int argc, char** argv) {
         frames->set_objects(setup.solids);
         if (continues_directory) frames->keep_earlier(frame_times);
     }
-    StatsTable stats(sim->stage_names(), scene.params.heat.enabled);
+    StatsTable stats(sim->stage_names(), sim->last_report().column_names);
     if (continues_directory) stats.keep_earlier_rows(stats_rows_up_to(stats_path, stats.header(), resume->step));
 
     RunSummary summary;
@@ -453,7 +453,7 @@ int command_run(int argc, char** argv) {
     const std::string shown = std::filesystem::absolute(out_dir, ec).lexically_normal().string();
     // The fluid's figures mean nothing in a scene without fluid (all zero): say so instead.
     char fluid_figures[160] = "no fluid";
-    if (summary.particles.by_type[kFluid] > 0 || stats.has_melting() || stats.has_emitters())
+    if (summary.particles.by_type[kFluid] > 0 || stats.has_column("melted") || stats.has_column("emitted"))
         std::snprintf(fluid_figures, sizeof fluid_figures, "density error avg %.3g%% max %.3g%%, %.1f iterations/step",
                       100 * stats.density_error_avg(), 100 * stats.density_error_max(), stats.iterations_avg());
     std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "apps/commands.hpp"
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace {
 void print_usage(std::FILE* to) {

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <string>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 namespace mw {
 

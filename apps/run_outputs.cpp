@@ -11,7 +11,7 @@
 
 #include "apps/atomic_file.hpp"
 #include "apps/vtu_writer.hpp"
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 
@@ -193,12 +193,25 @@ void FrameWriter::write_objects(int index, const HostParticles& p) const {
     }
 }
 
-StatsTable::StatsTable(std::vector<std::string> stage_names, bool heat)
+StatsTable::StatsTable(std::vector<std::string> stage_names, std::vector<std::string> columns)
     : stages_(std::move(stage_names)),
-      heat_(heat),
-      melting_(std::find(stages_.begin(), stages_.end(), "melting") != stages_.end()),
-      emitting_(std::find(stages_.begin(), stages_.end(), "emit") != stages_.end()),
+      columns_(std::move(columns)),
+      column_first_(columns_.size(), 0.0),
+      column_last_(columns_.size(), 0.0),
       stage_ms_(stages_.size()) {}
+
+std::size_t StatsTable::column_index(const std::string& name) const {
+    return std::size_t(std::find(columns_.begin(), columns_.end(), name) - columns_.begin());
+}
+bool StatsTable::has_column(const std::string& name) const { return column_index(name) < columns_.size(); }
+double StatsTable::column_first(const std::string& name) const {
+    const std::size_t k = column_index(name);
+    return k < columns_.size() ? column_first_[k] : 0.0;
+}
+double StatsTable::column_last(const std::string& name) const {
+    const std::size_t k = column_index(name);
+    return k < columns_.size() ? column_last_[k] : 0.0;
+}
 
 void StatsTable::add(const StepReport& r) {
     char buffer[256];
@@ -206,21 +219,13 @@ void StatsTable::add(const StepReport& r) {
                   r.iterations, r.density_error_avg, r.density_error_max, r.max_speed, r.kinetic_energy,
                   r.lost_particles, r.retries, r.diverged ? 1 : 0, r.unconverged ? 1 : 0);
     csv_rows_ += buffer;
-    if (heat_) {
-        std::snprintf(buffer, sizeof buffer, ",%.9g", r.heat_content);
+    // Counts print as integers in %.9g (up to 1e9), the heat content with 9 digits.
+    for (std::size_t k = 0; k < columns_.size(); ++k) {
+        const double value = k < r.columns.size() ? r.columns[k] : 0.0;
+        std::snprintf(buffer, sizeof buffer, ",%.9g", value);
         csv_rows_ += buffer;
-        if (total_ms_.empty()) heat_first_ = r.heat_content;
-        heat_last_ = r.heat_content;
-    }
-    if (melting_) {
-        std::snprintf(buffer, sizeof buffer, ",%ld", r.melted);
-        csv_rows_ += buffer;
-        melted_last_ = r.melted;
-    }
-    if (emitting_) {
-        std::snprintf(buffer, sizeof buffer, ",%ld", r.emitted);
-        csv_rows_ += buffer;
-        emitted_last_ = r.emitted;
+        if (total_ms_.empty()) column_first_[k] = value;
+        column_last_[k] = value;
     }
     for (std::size_t s = 0; s < stages_.size(); ++s) {
         const double ms = s < r.stage_ms.size() ? r.stage_ms[s] : 0.0;
@@ -244,9 +249,7 @@ std::string StatsTable::header() const {
     std::string h =
         "step,time,dt,iterations,density_error_avg,density_error_max,max_speed,kinetic_energy,lost_particles,"
         "dt_retries,diverged,unconverged";
-    if (heat_) h += ",heat_content";
-    if (melting_) h += ",melted";
-    if (emitting_) h += ",emitted";
+    for (const auto& c : columns_) h += "," + c;
     for (const auto& s : stages_) h += ",ms_" + s;
     return h + ",ms_total";
 }
@@ -351,16 +354,16 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     j["speed"] = {{"peak", finite_or_null(stats.peak_speed())},
                   {"limit", run.speed_limit > 0 ? SceneJson(run.speed_limit) : SceneJson(nullptr)}};
     // Heat conduction: the heat content (stats.csv) should stay constant; its change over the run.
-    if (stats.has_heat() && stats.rows() > 0) {
-        const double first = stats.heat_content_first(), last = stats.heat_content_last();
+    if (stats.has_column("heat_content") && stats.rows() > 0) {
+        const double first = stats.column_first("heat_content"), last = stats.column_last("heat_content");
         j["heat_content"] = {{"after_first_step", finite_or_null(first)},
                              {"at_end", finite_or_null(last)},
                              {"relative_change", finite_or_null(first != 0 ? (last - first) / std::fabs(first) : 0.0)}};
     }
     // Melting: the particles that have left their objects for the fluid by the end of the run.
-    if (stats.has_melting() && stats.rows() > 0) j["melted_particles"] = stats.melted_last();
+    if (stats.has_column("melted") && stats.rows() > 0) j["melted_particles"] = long(stats.column_last("melted"));
     // Emitters: the particles released by the end of the run.
-    if (stats.has_emitters() && stats.rows() > 0) j["emitted_particles"] = stats.emitted_last();
+    if (stats.has_column("emitted") && stats.rows() > 0) j["emitted_particles"] = long(stats.column_last("emitted"));
     j["device_bytes"] = run.device_bytes;
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "apps/scene.hpp"
 #include "surface/fluid_surface.hpp"
 
@@ -66,8 +66,9 @@ class FrameWriter {
 // atomically (so stats.csv is always whole). The numbers the summary needs are kept as columns.
 class StatsTable {
    public:
-    // `heat`: the scene conducts heat, and the table has a heat_content column.
-    explicit StatsTable(std::vector<std::string> stage_names, bool heat = false);
+    // `columns`: the modules' own columns (StepReport::column_names), after the fluid's and before
+    // the stages' times.
+    StatsTable(std::vector<std::string> stage_names, std::vector<std::string> columns);
     void add(const StepReport& report);
     // Rows of the run this one resumes (stats_rows_up_to), written before this run's; the figures
     // below cover this run's rows only.
@@ -91,26 +92,18 @@ class StatsTable {
     // The fastest particle, fluid or solid, over this run's steps, m/s.
     double peak_speed() const { return peak_speed_; }
     double sum_total_ms() const;
-    // With heat conduction: the heat content after this run's first step and after its last.
-    bool has_heat() const { return heat_; }
-    double heat_content_first() const { return heat_first_; }
-    double heat_content_last() const { return heat_last_; }
-    // With a melting object (the "melting" stage): a `melted` column, the particles melted so far.
-    bool has_melting() const { return melting_; }
-    long melted_last() const { return melted_last_; }
-    // With an emitter (the "emit" stage): an `emitted` column, the particles released so far.
-    bool has_emitters() const { return emitting_; }
-    long emitted_last() const { return emitted_last_; }
+    // The modules' columns: whether the table has one, and its value after this run's first step
+    // and after its last (heat_content: the heat's conservation; melted, emitted: the counts).
+    bool has_column(const std::string& name) const;
+    double column_first(const std::string& name) const;
+    double column_last(const std::string& name) const;
 
    private:
+    std::size_t column_index(const std::string& name) const;  // columns_.size() when absent
     std::vector<std::string> stages_;
-    bool heat_ = false;
+    std::vector<std::string> columns_;
+    std::vector<double> column_first_, column_last_;
     double peak_speed_ = 0;
-    double heat_first_ = 0, heat_last_ = 0;
-    bool melting_ = false;
-    long melted_last_ = 0;
-    bool emitting_ = false;
-    long emitted_last_ = 0;
     std::string earlier_rows_;                   // a resumed run's rows from before its checkpoint
     std::string csv_rows_;                       // every row so far, as written to stats.csv
     std::vector<std::vector<double>> stage_ms_;  // [stage][row]

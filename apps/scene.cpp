@@ -14,7 +14,7 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "sampling/wall_gap.hpp"
 
 namespace mw {

@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 namespace mw {
 

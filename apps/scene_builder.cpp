@@ -6,7 +6,7 @@
 #include <string>
 
 #include "algorithms/lsm_regions.hpp"
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/disc_lattice.hpp"
 #include "sampling/inside_outside.hpp"

@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "apps/scene.hpp"
 #include "sampling/fluid_clearance.hpp"
 #include "sampling/mesh.hpp"

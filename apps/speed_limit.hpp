@@ -6,7 +6,7 @@
 #pragma once
 #include <string>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "apps/scene.hpp"
 
 namespace mw {

@@ -10,4 +10,3 @@
 #else
 #error "define MW_BACKEND_CUDA or MW_BACKEND_OPENMP before including backend/backend.hpp"
 #endif
-#include "backend/scratch_user.hpp"

@@ -6,7 +6,6 @@
 //   void to_host(void* dst, const void* src, std::size_t bytes)     backend -> host
 //   void within(void* dst, const void* src, std::size_t bytes)      backend -> backend
 //   template <class T> void fill(T* p, std::size_t n, T value)
-//   MemoryLedger& ledger()
 // Each backend names its own `DeviceArray<T> = BasicDeviceArray<T, ItsSpace>`; the different
 // Space types keep the two backends' symbols apart.
 #pragma once
@@ -15,7 +14,6 @@
 #include <utility>
 #include <vector>
 
-#include "backend/memory_ledger.hpp"
 #include "backend/view.hpp"
 
 namespace mw {
@@ -47,15 +45,11 @@ class BasicDeviceArray {
             release();
             ptr_ = static_cast<T*>(Space::allocate(n * sizeof(T)));
             capacity_ = n;
-            Space::ledger().add(static_cast<std::int64_t>(capacity_ * sizeof(T)));
         }
         size_ = n;
     }
     void release() {
-        if (ptr_) {
-            Space::ledger().remove(static_cast<std::int64_t>(capacity_ * sizeof(T)));
-            Space::release(ptr_);
-        }
+        if (ptr_) Space::release(ptr_);
         ptr_ = nullptr;
         size_ = capacity_ = 0;
     }

@@ -42,7 +42,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/scene.hpp"
 #include "apps/scene_builder.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/wall_gap.hpp"
 #include "surface/fluid_surface.hpp"
@@ -599,7 +599,7 @@ int main(int argc, char** argv) {
                     const std::vector<std::string> names = sim.stage_names();
                     const StepReport& rep = sim.last_report();
                     step_ms.push_back(rep.total_ms);
-                    if (rep.heat_substeps > 0) substeps.push_back(rep.heat_substeps);
+                    if (rep.value("heat_substeps") > 0) substeps.push_back(int(rep.value("heat_substeps")));
                     for (std::size_t k = 0; k < names.size() && k < rep.stage_ms.size(); ++k) {
                         if (names[k] == "heat") heat_ms.push_back(rep.stage_ms[k]);
                         if (names[k] == "pcisph") pcisph_ms.push_back(rep.stage_ms[k]);
@@ -649,8 +649,8 @@ int main(int argc, char** argv) {
                     const std::vector<std::string> names = sim.stage_names();
                     const StepReport& rep = sim.last_report();
                     step_ms.push_back(rep.total_ms);
-                    const bool melted_now = rep.melted > melted;
-                    melted = rep.melted;
+                    const bool melted_now = long(rep.value("melted")) > melted;
+                    melted = long(rep.value("melted"));
                     for (std::size_t k = 0; k < names.size() && k < rep.stage_ms.size(); ++k) {
                         if (names[k] == "melting") (melted_now ? melt_step_ms : quiet_ms).push_back(rep.stage_ms[k]);
                         if (names[k] == "lsm") lsm_ms.push_back(rep.stage_ms[k]);

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "apps/scene_builder.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "sampling/procedural_meshes.hpp"
 
 using namespace mw;

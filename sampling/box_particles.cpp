@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

@@ -14,7 +14,7 @@
 #include <embree3/rtcore.h>
 #include <omp.h>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "sampling/embree_mesh.hpp"
 #include "sampling/first_exception.hpp"
 #include "sampling/winding_number.hpp"

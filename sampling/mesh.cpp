@@ -8,7 +8,7 @@
 
 #include <Eigen/Geometry>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

@@ -10,7 +10,7 @@
 
 #include <tiny_obj_loader.h>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

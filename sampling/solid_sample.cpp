@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

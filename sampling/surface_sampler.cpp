@@ -9,7 +9,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "sampling/kdtree.hpp"
 
 namespace mw {

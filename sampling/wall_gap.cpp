@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 

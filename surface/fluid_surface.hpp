@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "sampling/mesh.hpp"
 
 namespace mw {

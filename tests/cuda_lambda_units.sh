@@ -6,7 +6,7 @@
 # template that the linker keeps from one unit only. A lambda written in a non-template function
 # has the same type in every unit that compiles it, so a program can make the lambda in one unit
 # and copy it with the other unit's copier, which that unit never set: a call through a null
-# pointer (backend/cuda/simulation_cuda.cu says how it showed). No GPU is needed to see it: the
+# pointer (simulation/instantiate_cuda.cu says how it showed). No GPU is needed to see it: the
 # symbol tables tell.
 #
 # Usage: tests/cuda_lambda_units.sh FILE...   object files or static libraries (each archive
@@ -31,7 +31,7 @@ if [[ -n "$shared" ]]; then
     ((++shown <= 10)) || continue
     echo "  $(c++filt <<<"$name" | cut -c1-160) ...; in:$where"
   done <<<"$shared"
-  echo "Instantiate every algorithm that uses them in one unit (backend/cuda/simulation_cuda.cu)."
+  echo "Instantiate every algorithm that uses them in one unit (simulation/instantiate_cuda.cu)."
   exit 1
 fi
 echo "cuda_lambda_units: $lambdas extended lambdas in $units units, none in two"

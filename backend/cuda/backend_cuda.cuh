@@ -1,6 +1,6 @@
 // CUDA backend: cudaMalloc'd arrays, one templated kernel for parallel_for with a block size chosen
-// once per lambda type, CUB reductions/scans/sorts on a persistent workspace (no per-call device
-// allocation), CUDA-event stage timers. Same API, name for name, as backend/openmp/backend_openmp.hpp.
+// once per kernel and device, CUB reductions/scans/sorts on the context's persistent workspace (no
+// per-call device allocation), CUDA-event stage timers. Same API, name for name, as backend/openmp/backend_openmp.hpp.
 #pragma once
 #include <cuda_runtime.h>
 
@@ -9,13 +9,13 @@
 #include <cub/device/device_scan.cuh>
 #include <thrust/iterator/counting_iterator.h>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "backend/config.hpp"
 #include "backend/device_array.hpp"
-#include "backend/errors.hpp"
-#include "backend/memory_ledger.hpp"
+#include "common/errors.hpp"
 #include "backend/reduce_ops.hpp"
 #include "backend/view.hpp"
 
@@ -36,30 +36,14 @@ constexpr bool kPrefersNeighborLists = false;
 
 constexpr const char* kBackendName = "cuda";
 
-inline MemoryLedger& memory_ledger() {
-    static MemoryLedger ledger;
-    return ledger;
-}
-
-void set_threads(int threads);  // no effect on the GPU; kept for a uniform command line
-int thread_count();
 bool backend_available();          // a CUDA device is present and usable
 std::string unavailable_reason();  // why not, in the driver's words ("" when available)
-std::string device_description();  // e.g. "NVIDIA H100 80GB HBM3 (sm_90, 79.1 GiB)"
-std::int64_t device_memory_free();
-int multiprocessor_count();  // of the current device, read once
-void synchronize();
+std::int64_t device_memory_free(); // of the current device, bytes
 // Set MELTWATER_CUDA_SYNC=1 to synchronise and check after every launch (debug mode, as PBRT).
 bool debug_sync_enabled();
 void check_cuda(cudaError_t status, const char* what);
-void check_launch(const char* name);
 
-// Scratch memory shared by every CUB call of this backend; grows, never shrinks.
-void* cub_workspace(std::size_t bytes);
-// A small pinned host buffer for reduction results, so a reduction costs one small copy.
-void* pinned_scratch(std::size_t bytes);
-
-// GPU global memory.
+// GPU global memory, on the device current on the calling thread (DeviceContext::activate).
 struct CudaSpace {
     static void* allocate(std::size_t bytes) {
         void* p = nullptr;
@@ -67,8 +51,7 @@ struct CudaSpace {
         if (status == cudaErrorMemoryAllocation) {
             (void)cudaGetLastError();
             throw DeviceError("out of GPU memory allocating " + std::to_string(bytes) + " bytes (" +
-                              std::to_string(memory_ledger().current.load()) + " bytes already held, " +
-                              std::to_string(device_memory_free()) + " free)");
+                              std::to_string(device_memory_free()) + " bytes free on the device)");
         }
         // Anything else (often an error left by an earlier kernel) is not a memory shortage.
         check_cuda(status, "allocating GPU memory");
@@ -85,12 +68,56 @@ struct CudaSpace {
         check_cuda(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToDevice), "copy on the GPU");
     }
     template <class T>
-    static void fill(T* p, std::size_t n, T value);  // after parallel_for, below
-    static MemoryLedger& ledger() { return memory_ledger(); }
+    static void fill(T* p, std::size_t n, T value);  // after the kernels, below
 };
 
 template <class T>
 using DeviceArray = BasicDeviceArray<T, CudaSpace>;
+
+// Everything one simulation's launches share on a GPU: the device and the stream they run on,
+// CUB's workspace, a pinned host buffer and a device slot for reduction results, and each kernel's
+// block size. A simulation owns one and passes it to every launch; two simulations in one process
+// share nothing, so each may live on a device of its own. The stream is the device's legacy
+// default stream, so that the arrays' plain copies stay ordered with the launches.
+class DeviceContext {
+   public:
+    explicit DeviceContext(int device = 0);
+    ~DeviceContext();
+    DeviceContext(const DeviceContext&) = delete;
+    DeviceContext& operator=(const DeviceContext&) = delete;
+
+    int device() const { return device_; }
+    cudaStream_t stream() const { return stream_; }
+    int multiprocessors() const { return multiprocessors_; }
+    std::string description() const;  // e.g. "NVIDIA H100 80GB HBM3 (sm_90, 79.1 GiB)"
+    // Makes this context's device current on the calling thread: a simulation calls it on entry.
+    void activate() const;
+    void synchronize() const { check_cuda(cudaStreamSynchronize(stream_), "synchronize"); }
+    void check_launch(const char* name) const;
+    // Bytes held between calls: CUB's workspace (the radix sort's is the large one, about 8 bytes
+    // per sorted item, kept with half again as headroom), the pinned buffer and the result slot.
+    std::size_t scratch_bytes() const;
+
+    void* workspace(std::size_t bytes) const;   // CUB's temporary storage; grows, never shrinks
+    void* pinned(std::size_t bytes) const;      // small pinned host memory for reduction results
+    void* result_slot(std::size_t bytes) const; // device memory for one reduction result, zeroed once
+    // The block size for `kernel` launched over n items (parallel_for): the occupancy
+    // calculator's choice, computed once per kernel on this device, capped at 256 (it returns the
+    // largest block that reaches full occupancy, up to 1024, which leaves most multiprocessors idle
+    // on small scenes) and kept a whole number of warps; then halved, down to 64 and in whole
+    // warps, until the launch has at least two blocks per multiprocessor.
+    int block_size(const void* kernel, std::size_t n) const;
+
+   private:
+    int device_ = 0;
+    cudaStream_t stream_ = 0;
+    int multiprocessors_ = 1;
+    bool debug_sync_ = false;  // MELTWATER_CUDA_SYNC, read once
+    mutable DeviceArray<unsigned char> workspace_, result_;
+    mutable void* pinned_ = nullptr;
+    mutable std::size_t pinned_bytes_ = 0;
+    mutable std::unordered_map<const void*, int> largest_block_;
+};
 
 template <class F>
 __global__ void parallel_for_kernel(std::size_t n, F f) {
@@ -98,42 +125,28 @@ __global__ void parallel_for_kernel(std::size_t n, F f) {
     if (i < n) f(i);
 }
 
-// Block size: the occupancy calculator's choice for the kernel, computed once per lambda type,
-// capped at 256 (it returns the largest block that reaches full occupancy, up to 1024, which
-// leaves most multiprocessors idle on small scenes) and kept a whole number of warps; then halved,
-// down to 64 and in whole warps, until the launch has at least two blocks per multiprocessor.
 template <class F>
-int block_size_for(std::size_t n) {
-    static const int largest = [] {
-        int min_grid = 0, best = 256;
-        if (cudaOccupancyMaxPotentialBlockSize(&min_grid, &best, parallel_for_kernel<F>, 0, 0) != cudaSuccess) {
-            (void)cudaGetLastError();
-            best = 256;
-        }
-        best = best < 256 ? best : 256;
-        return best < 64 ? best : best / 32 * 32;
-    }();
-    const std::size_t enough_blocks = 2 * static_cast<std::size_t>(multiprocessor_count());
-    int block = largest;
-    while (block > 64 && (n + block - 1) / block < enough_blocks) {
-        const int half = block / 2 / 32 * 32;
-        block = half > 64 ? half : 64;
-    }
-    return block;
-}
-
-template <class F>
-void parallel_for(const char* name, std::size_t n, F f) {
+void parallel_for(const DeviceContext& device, const char* name, std::size_t n, F f) {
     if (n == 0) return;
-    const int block = block_size_for<F>(n);
+    const int block = device.block_size(reinterpret_cast<const void*>(parallel_for_kernel<F>), n);
     const std::size_t grid = (n + block - 1) / block;
-    parallel_for_kernel<F><<<static_cast<unsigned>(grid), block>>>(n, f);
-    check_launch(name);
+    parallel_for_kernel<F><<<static_cast<unsigned>(grid), block, 0, device.stream()>>>(n, f);
+    device.check_launch(name);
 }
 
 template <class T>
+__global__ void fill_kernel(T* p, std::size_t n, T value) {
+    const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < n) p[i] = value;
+}
+
+// On the legacy default stream, which every context's launches share (DeviceContext).
+template <class T>
 void CudaSpace::fill(T* p, std::size_t n, T value) {
-    parallel_for("DeviceArray::fill", n, [=] __device__(std::size_t i) { p[i] = value; });
+    if (n == 0) return;
+    fill_kernel<T><<<static_cast<unsigned>((n + 255) / 256), 256>>>(p, n, value);
+    check_cuda(cudaGetLastError(), "DeviceArray::fill");
+    if (debug_sync_enabled()) check_cuda(cudaDeviceSynchronize(), "DeviceArray::fill");
 }
 
 // Applies f to an index; lets CUB read f(i) through a counting iterator.
@@ -145,59 +158,52 @@ struct IndexTransform {
 
 // CUB's reduction has a fixed order for a given size and device, so results are reproducible.
 template <class T, class Op, class F>
-T transform_reduce(const char* name, std::size_t n, T identity, Op op, F f) {
+T transform_reduce(const DeviceContext& device, const char* name, std::size_t n, T identity, Op op, F f) {
     if (n == 0) return identity;
-    // Zeroed once: CUB writes only T's members, and copying back padding it never wrote (a float
-    // build's DensityError) would be an uninitialised read to compute-sanitizer's initcheck.
-    static DeviceArray<T> device_result = [] {
-        DeviceArray<T> result(1);
-        check_cuda(cudaMemset(result.view().data(), 0, sizeof(T)), "reduction result");
-        return result;
-    }();
+    // Zeroed once (result_slot): CUB writes only T's members, and copying back padding it never
+    // wrote (a float build's DensityError) would be an uninitialised read to compute-sanitizer's
+    // initcheck.
+    T* result = static_cast<T*>(device.result_slot(sizeof(T)));
     thrust::counting_iterator<std::size_t> first(0);
     IndexTransform<T, F> transform{f};
     std::size_t temp_bytes = 0;
-    check_cuda(cub::DeviceReduce::TransformReduce(nullptr, temp_bytes, first, device_result.view().data(),
-                                                  static_cast<std::int64_t>(n), op, transform, identity),
+    check_cuda(cub::DeviceReduce::TransformReduce(nullptr, temp_bytes, first, result, static_cast<std::int64_t>(n),
+                                                  op, transform, identity, device.stream()),
                name);
-    void* temp = cub_workspace(temp_bytes);
-    check_cuda(cub::DeviceReduce::TransformReduce(temp, temp_bytes, first, device_result.view().data(),
-                                                  static_cast<std::int64_t>(n), op, transform, identity),
+    void* temp = device.workspace(temp_bytes);
+    check_cuda(cub::DeviceReduce::TransformReduce(temp, temp_bytes, first, result, static_cast<std::int64_t>(n), op,
+                                                  transform, identity, device.stream()),
                name);
-    T* host = static_cast<T*>(pinned_scratch(sizeof(T)));
-    check_cuda(cudaMemcpy(host, device_result.view().data(), sizeof(T), cudaMemcpyDeviceToHost), name);
+    T* host = static_cast<T*>(device.pinned(sizeof(T)));
+    check_cuda(cudaMemcpyAsync(host, result, sizeof(T), cudaMemcpyDeviceToHost, device.stream()), name);
+    check_cuda(cudaStreamSynchronize(device.stream()), name);
     return *host;
 }
 
 // Returns the total. The last input (read before the scan, which may work in place) and the last
 // output are copied into pinned memory on the stream, so the call costs one synchronisation.
 template <class T>
-T exclusive_scan(const char* name, View<const T> in, View<T> out) {
+T exclusive_scan(const DeviceContext& device, const char* name, View<const T> in, View<T> out) {
     const std::size_t n = in.size();
     if (n == 0) return T(0);
-    T* ends = static_cast<T*>(pinned_scratch(2 * sizeof(T)));
-    check_cuda(cudaMemcpyAsync(&ends[0], in.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
+    T* ends = static_cast<T*>(device.pinned(2 * sizeof(T)));
+    check_cuda(cudaMemcpyAsync(&ends[0], in.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost, device.stream()), name);
     std::size_t temp_bytes = 0;
-    check_cuda(cub::DeviceScan::ExclusiveSum(nullptr, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n)),
+    check_cuda(cub::DeviceScan::ExclusiveSum(nullptr, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n),
+                                             device.stream()),
                name);
-    void* temp = cub_workspace(temp_bytes);
-    check_cuda(cub::DeviceScan::ExclusiveSum(temp, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n)),
+    void* temp = device.workspace(temp_bytes);
+    check_cuda(cub::DeviceScan::ExclusiveSum(temp, temp_bytes, in.data(), out.data(), static_cast<std::int64_t>(n),
+                                             device.stream()),
                name);
-    check_cuda(cudaMemcpyAsync(&ends[1], out.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost), name);
-    check_cuda(cudaStreamSynchronize(0), name);
+    check_cuda(cudaMemcpyAsync(&ends[1], out.data() + n - 1, sizeof(T), cudaMemcpyDeviceToHost, device.stream()), name);
+    check_cuda(cudaStreamSynchronize(device.stream()), name);
     return ends[0] + ends[1];
 }
 
-void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
-                View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
-
-// Scratch the backend keeps between calls and that no DeviceArray owner counts: CUB's workspace,
-// shared by every sort, scan and reduction of the process (the radix sort's is the large one,
-// about 8 bytes per sorted item, held with half again as headroom). Grows while a simulation
-// lives; release_backend_scratch (called when the last one goes, backend/scratch_user.hpp) frees
-// it.
-std::size_t backend_scratch_bytes();
-void release_backend_scratch();
+void sort_pairs(const DeviceContext& device, const char* name, View<const std::uint32_t> keys_in,
+                View<std::uint32_t> keys_out, View<const std::uint32_t> values_in, View<std::uint32_t> values_out,
+                int key_bits);
 
 // Atomics are called from host/device lambdas; only the device path runs on this backend.
 #if defined(__CUDA_ARCH__)
@@ -221,7 +227,7 @@ MW_INLINE void atomic_add(double* address, double value) {
 // Stage timers on CUDA events: no synchronisation until read(), once per step.
 class StageTimers {
    public:
-    explicit StageTimers(int stage_count);
+    StageTimers(const DeviceContext& device, int stage_count);
     ~StageTimers();
     StageTimers(const StageTimers&) = delete;
     StageTimers& operator=(const StageTimers&) = delete;
@@ -230,6 +236,7 @@ class StageTimers {
     void read(double* ms_out);
 
    private:
+    cudaStream_t stream_ = 0;
     std::vector<cudaEvent_t> start_, stop_;
     std::vector<char> used_;
 };

@@ -8,16 +8,11 @@
 
 MW_BACKEND_BEGIN
 
-void set_threads(int threads) {
-    if (threads > 0) omp_set_num_threads(threads);
-}
-
-int thread_count() { return omp_get_max_threads(); }
-
-void start_thread_team() {
+void start_thread_team(int threads) {
     // An empty region would be dropped by the compiler, hence the call inside.
     int team = 0;
-#pragma omp parallel
+    const int width = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel num_threads(width)
     {
 #pragma omp single
         team = omp_get_num_threads();
@@ -25,7 +20,14 @@ void start_thread_team() {
     (void)team;
 }
 
+void set_host_threads(int threads) {
+    if (threads > 0) omp_set_num_threads(threads);
+    start_thread_team(threads);
+}
+
 bool backend_available() { return true; }
+
+DeviceContext::DeviceContext(int threads) : threads_(threads > 0 ? threads : omp_get_max_threads()) {}
 
 static std::string cpu_model() {
     std::ifstream cpuinfo("/proc/cpuinfo");
@@ -39,8 +41,8 @@ static std::string cpu_model() {
     return "unknown CPU";
 }
 
-std::string device_description() {
-    return std::to_string(thread_count()) + " OpenMP threads on " + cpu_model();
+std::string DeviceContext::description() const {
+    return std::to_string(threads_) + (threads_ == 1 ? " OpenMP thread on " : " OpenMP threads on ") + cpu_model();
 }
 
 std::int64_t device_memory_free() {
@@ -51,36 +53,23 @@ std::int64_t device_memory_free() {
 
 // Stable LSD radix sort of (key, value) pairs on the low `key_bits` bits of the keys, as CUB's
 // DeviceRadixSort::SortPairs does on the GPU. Hand-written, against the project's preference for
-// libraries, because the ones at hand fall short here: GNU's parallel mergesort (used before)
-// allocates n-sized temporaries on every call, and TBB's parallel_sort runs on its own thread pool,
-// outside OpenMP and --threads. Called every step by the neighbour grid, so:
-//  * Scratch persists across calls and only grows: same-size or smaller calls allocate nothing.
+// libraries, because the ones at hand fall short here: GNU's parallel mergesort allocates n-sized
+// temporaries on every call, and TBB's parallel_sort runs on its own thread pool, outside OpenMP
+// and --threads. Called every step by the neighbour grid, so:
+//  * Scratch is the context's and only grows: same-size or smaller calls allocate nothing.
 //  * Stability is by input position (never by value), and each thread owns a fixed contiguous
 //    chunk whose elements keep their order within every bucket, so the output is the one stable
 //    order whatever the thread count; runs stay bitwise reproducible.
 //  * Only as many passes as key_bits needs, each at most 11 bits wide (a 2048-entry histogram per
 //    thread stays in L1/L2), split evenly: 24 bits -> 3 passes of 8, 31 bits -> 3 passes of 11.
-namespace {
-struct RadixScratch {
-    std::vector<std::uint32_t> keys, values;  // the ping-pong partner of keys_out / values_out
-    std::vector<std::size_t> offsets;         // [thread][digit]: counts, then scatter positions
-};
-// Per calling thread, so concurrent callers are safe.
-RadixScratch& radix_scratch() {
-    static thread_local RadixScratch scratch;
-    return scratch;
-}
-}  // namespace
-
-std::size_t backend_scratch_bytes() {
-    const RadixScratch& s = radix_scratch();
-    return (s.keys.capacity() + s.values.capacity()) * sizeof(std::uint32_t) + s.offsets.capacity() * sizeof(std::size_t);
+std::size_t DeviceContext::scratch_bytes() const {
+    return (sort_.keys.capacity() + sort_.values.capacity()) * sizeof(std::uint32_t) +
+           sort_.offsets.capacity() * sizeof(std::size_t) + partials_.capacity() * sizeof(Word);
 }
 
-void release_backend_scratch() { radix_scratch() = RadixScratch{}; }
-
-void sort_pairs(const char* /*name*/, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
-                View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits) {
+void sort_pairs(const DeviceContext& device, const char* /*name*/, View<const std::uint32_t> keys_in,
+                View<std::uint32_t> keys_out, View<const std::uint32_t> values_in, View<std::uint32_t> values_out,
+                int key_bits) {
     const std::size_t n = keys_in.size();
     if (n == 0) return;
     constexpr int kMaxDigitBits = 11;
@@ -91,9 +80,9 @@ void sort_pairs(const char* /*name*/, View<const std::uint32_t> keys_in, View<st
     // Small inputs sort on one thread, where fork/join and barriers would dominate (threshold
     // not tuned); the result is the same for any thread count.
     constexpr std::size_t kParallelMin = 1 << 14;
-    const int max_threads = n < kParallelMin ? 1 : omp_get_max_threads();
+    const int max_threads = n < kParallelMin ? 1 : device.threads();
 
-    RadixScratch& scratch = radix_scratch();
+    DeviceContext::SortScratch& scratch = device.sort_scratch();
     if (scratch.keys.size() < n) {
         scratch.keys.resize(n);
         scratch.values.resize(n);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <cstddef>
 #include <cstring>
 #include <string>
 #include <utility>
@@ -13,8 +14,7 @@
 
 #include "backend/config.hpp"
 #include "backend/device_array.hpp"
-#include "backend/errors.hpp"
-#include "backend/memory_ledger.hpp"
+#include "common/errors.hpp"
 #include "backend/reduce_ops.hpp"
 #include "backend/view.hpp"
 
@@ -32,18 +32,14 @@ constexpr bool kPrefersNeighborLists = true;
 
 constexpr const char* kBackendName = "openmp";
 
-inline MemoryLedger& memory_ledger() {
-    static MemoryLedger ledger;
-    return ledger;
-}
-
-void set_threads(int threads);        // 0 keeps the OpenMP default
-void start_thread_team();             // creates the threads now (libgomp exits if it cannot)
-int thread_count();
 bool backend_available();             // always true on the CPU
-std::string device_description();     // e.g. "2 OpenMP threads on Intel Xeon ..."
 std::int64_t device_memory_free();    // physical memory available, bytes
-inline void synchronize() {}
+// Creates OpenMP's thread team now, `threads` wide (0: OpenMP's default): libgomp ends the
+// process when it cannot create the threads, and that had better happen before any output.
+void start_thread_team(int threads);
+// The width of the host's own parallel loops (sampling meshes, outside any simulation), and its
+// team started at once; 0 keeps OpenMP's default.
+void set_host_threads(int threads);
 
 // Host memory, 64-byte aligned.
 struct HostSpace {
@@ -62,17 +58,56 @@ struct HostSpace {
 #pragma omp parallel for schedule(static)
         for (std::ptrdiff_t i = 0; i < count; ++i) p[i] = value;
     }
-    static MemoryLedger& ledger() { return memory_ledger(); }
 };
 
 template <class T>
 using DeviceArray = BasicDeviceArray<T, HostSpace>;
 
+// Everything one simulation's launches share on the CPU: the thread count of its parallel
+// regions, and the scratch its reductions, scans and sorts keep between calls (they grow, never
+// shrink, so that a step allocates nothing once the first has run). A simulation owns one and
+// passes it to every launch; two simulations in one process share nothing.
+class DeviceContext {
+   public:
+    // `threads`: the width of every parallel region (0: OpenMP's default at construction).
+    explicit DeviceContext(int threads = 0);
+    DeviceContext(const DeviceContext&) = delete;
+    DeviceContext& operator=(const DeviceContext&) = delete;
+
+    int threads() const { return threads_; }
+    std::string description() const;  // e.g. "2 OpenMP threads on Intel Xeon ..."
+    // Makes this context's device current on the calling thread (nothing to do on the CPU).
+    void activate() const {}
+    void synchronize() const {}
+    // Bytes held between calls: the sort's ping-pong buffers and the reductions' partials.
+    std::size_t scratch_bytes() const;
+
+    // At least `count` elements of T for a reduction's or scan's per-chunk partials.
+    template <class T>
+    T* partials(std::size_t count) const {
+        const std::size_t words = (count * sizeof(T) + sizeof(Word) - 1) / sizeof(Word);
+        if (partials_.size() < words) partials_.resize(words);
+        return reinterpret_cast<T*>(partials_.data());
+    }
+    // The radix sort's buffers (backend_openmp.cpp).
+    struct SortScratch {
+        std::vector<std::uint32_t> keys, values;  // the ping-pong partner of the outputs
+        std::vector<std::size_t> offsets;         // [thread][digit]: counts, then scatter positions
+    };
+    SortScratch& sort_scratch() const { return sort_; }
+
+   private:
+    using Word = std::max_align_t;
+    int threads_ = 1;
+    mutable std::vector<Word> partials_;
+    mutable SortScratch sort_;
+};
+
 // f(i) for i in [0, n). `name` identifies the launch in errors and profiles.
 template <class F>
-void parallel_for(const char* /*name*/, std::size_t n, F f) {
+void parallel_for(const DeviceContext& device, const char* /*name*/, std::size_t n, F f) {
     const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(device.threads())
     for (std::ptrdiff_t i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
 }
 
@@ -80,21 +115,13 @@ void parallel_for(const char* /*name*/, std::size_t n, F f) {
 // reproducible from run to run and across --threads settings.
 constexpr std::size_t kReduceChunk = 4096;
 
-template <class T>
-std::vector<T>& reduction_workspace() {
-    static thread_local std::vector<T> partials;
-    return partials;
-}
-
 // op-reduction of f(i) over [0, n), starting from `identity`.
 template <class T, class Op, class F>
-T transform_reduce(const char* /*name*/, std::size_t n, T identity, Op op, F f) {
+T transform_reduce(const DeviceContext& device, const char* /*name*/, std::size_t n, T identity, Op op, F f) {
     const std::size_t chunks = (n + kReduceChunk - 1) / kReduceChunk;
-    std::vector<T>& partials = reduction_workspace<T>();
-    if (partials.size() < chunks) partials.resize(chunks);
-    T* part = partials.data();
+    T* part = device.partials<T>(chunks);
     const std::ptrdiff_t chunk_count = static_cast<std::ptrdiff_t>(chunks);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(device.threads())
     for (std::ptrdiff_t c = 0; c < chunk_count; ++c) {
         T acc = identity;
         const std::size_t begin = static_cast<std::size_t>(c) * kReduceChunk;
@@ -109,14 +136,12 @@ T transform_reduce(const char* /*name*/, std::size_t n, T identity, Op op, F f) 
 
 // out[i] = in[0] + ... + in[i-1]; returns the total. `out` may alias `in`.
 template <class T>
-T exclusive_scan(const char* /*name*/, View<const T> in, View<T> out) {
+T exclusive_scan(const DeviceContext& device, const char* /*name*/, View<const T> in, View<T> out) {
     const std::size_t n = in.size();
     const std::size_t chunks = (n + kReduceChunk - 1) / kReduceChunk;
-    std::vector<T>& partials = reduction_workspace<T>();
-    if (partials.size() < chunks + 1) partials.resize(chunks + 1);
-    T* part = partials.data();
+    T* part = device.partials<T>(chunks + 1);
     const std::ptrdiff_t chunk_count = static_cast<std::ptrdiff_t>(chunks);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(device.threads())
     for (std::ptrdiff_t c = 0; c < chunk_count; ++c) {
         T acc = T(0);
         const std::size_t begin = static_cast<std::size_t>(c) * kReduceChunk;
@@ -130,7 +155,7 @@ T exclusive_scan(const char* /*name*/, View<const T> in, View<T> out) {
         part[c] = running;
         running += chunk_sum;
     }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(device.threads())
     for (std::ptrdiff_t c = 0; c < chunk_count; ++c) {
         T acc = part[c];
         const std::size_t begin = static_cast<std::size_t>(c) * kReduceChunk;
@@ -146,17 +171,11 @@ T exclusive_scan(const char* /*name*/, View<const T> in, View<T> out) {
 
 // Sorts (key, value) pairs by key, stably (equal keys keep their input order), looking only at the
 // low `key_bits` bits of the keys, like the GPU radix sort. A parallel LSD radix sort whose output
-// does not depend on the thread count; its scratch persists across calls (see the .cpp). The
-// outputs must not alias the inputs (CUB's sort requires the same).
-void sort_pairs(const char* name, View<const std::uint32_t> keys_in, View<std::uint32_t> keys_out,
-                View<const std::uint32_t> values_in, View<std::uint32_t> values_out, int key_bits);
-
-// Scratch the backend keeps between calls and that no DeviceArray owner counts: the sort's
-// ping-pong buffers (8 bytes per sorted item) of the calling thread. Grows while a simulation
-// lives; release_backend_scratch (called when the last one goes, backend/scratch_user.hpp) frees
-// the calling thread's.
-std::size_t backend_scratch_bytes();
-void release_backend_scratch();
+// does not depend on the thread count; its scratch is the context's. The outputs must not alias
+// the inputs (CUB's sort requires the same).
+void sort_pairs(const DeviceContext& device, const char* name, View<const std::uint32_t> keys_in,
+                View<std::uint32_t> keys_out, View<const std::uint32_t> values_in, View<std::uint32_t> values_out,
+                int key_bits);
 
 MW_INLINE void atomic_add(int* address, int value) { __atomic_fetch_add(address, value, __ATOMIC_RELAXED); }
 MW_INLINE void atomic_add(unsigned* address, unsigned value) {
@@ -175,7 +194,7 @@ MW_INLINE void atomic_add(double* address, double value) {
 // returns each stage's milliseconds for the step and clears them.
 class StageTimers {
    public:
-    explicit StageTimers(int stage_count) : start_(stage_count), elapsed_ms_(stage_count, 0.0) {}
+    StageTimers(const DeviceContext& /*device*/, int stage_count) : start_(stage_count), elapsed_ms_(stage_count, 0.0) {}
     void start(int stage) { start_[stage] = std::chrono::steady_clock::now(); }
     void stop(int stage) {
         elapsed_ms_[stage] +=

@@ -7,7 +7,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/scene.hpp"
 #include "apps/scene_builder.hpp"
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "cli_helpers.hpp"
 
 using namespace mw;

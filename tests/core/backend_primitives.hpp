@@ -27,18 +27,18 @@ inline std::vector<int> random_values(std::size_t n, unsigned seed) {
 // which the small scenes take) to many blocks with a partial tail.
 constexpr std::size_t kReductionSizes[] = {0, 1, 7, 1000, kPrimitiveCount};
 
-inline void check_reductions() {
+inline void check_reductions(const DeviceContext& device) {
     for (const std::size_t n : kReductionSizes) {
         CAPTURE(n);
         const std::vector<int> values = random_values(n, 7);
         DeviceArray<int> data;
         data.upload(values);
         const View<const int> d = data.cview();
-        CHECK(transform_reduce("sum", n, 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
+        CHECK(transform_reduce(device, "sum", n, 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
               std::accumulate(values.begin(), values.end(), 0L));
-        CHECK(transform_reduce("min", n, 1 << 30, MinOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
+        CHECK(transform_reduce(device, "min", n, 1 << 30, MinOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
               (n ? *std::min_element(values.begin(), values.end()) : 1 << 30));
-        CHECK(transform_reduce("max", n, -(1 << 30), MaxOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
+        CHECK(transform_reduce(device, "max", n, -(1 << 30), MaxOp{}, [=] MW_HD(std::size_t i) { return d[i]; }) ==
               (n ? *std::max_element(values.begin(), values.end()) : -(1 << 30)));
     }
 }
@@ -46,7 +46,7 @@ inline void check_reductions() {
 // The solver's own reductions over structs of mixed members (pcisph.hpp): the density error (a
 // double sum and a Real maximum) and the motion summary (a double sum, a Real maximum and the
 // lowest index of a bad value). Every member must come back, at every size.
-inline void check_struct_reductions() {
+inline void check_struct_reductions(const DeviceContext& device) {
     for (const std::size_t n : kReductionSizes) {
         CAPTURE(n);
         const std::vector<int> values = random_values(n, 19);
@@ -55,12 +55,11 @@ inline void check_struct_reductions() {
         const View<const int> d = data.cview();
         // Values of -500 and -499 are "bad"; the lowest such index must win.
         const MotionSummary motion =
-            transform_reduce("motion summary", n, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
+            transform_reduce(device, "motion summary", n, MotionSummary{}, MotionSummaryOp{}, [=] MW_HD(std::size_t i) {
                 const int v = d[i];
                 return MotionSummary{0.5 * v, Real(v > 0 ? v : 0), v <= -499 ? static_cast<std::uint32_t>(i) : 0xffffffffu};
             });
-        const DensityError density = transform_reduce(
-            "density error", n, DensityError{}, DensityErrorOp{},
+        const DensityError density = transform_reduce(device, "density error", n, DensityError{}, DensityErrorOp{},
             [=] MW_HD(std::size_t i) { return DensityError{0.25 * d[i], Real(d[i] < 0 ? -d[i] : 0)}; });
         double sum = 0, quarter_sum = 0;
         Real max = 0, max_negative = 0;
@@ -83,7 +82,7 @@ inline void check_struct_reductions() {
 
 // A scan and a reduction back to back, twice: on a GPU both return their result through the same
 // small pinned host buffer.
-inline void check_scan_then_reduce() {
+inline void check_scan_then_reduce(const DeviceContext& device) {
     const std::vector<int> values = random_values(kPrimitiveCount, 23);
     DeviceArray<int> data, scanned(values.size());
     data.upload(values);
@@ -92,8 +91,8 @@ inline void check_scan_then_reduce() {
     const long total_long = std::accumulate(values.begin(), values.end(), 0L);
     for (int round = 0; round < 2; ++round) {
         CAPTURE(round);
-        CHECK(exclusive_scan("scan", data.cview(), scanned.view()) == total);
-        CHECK(transform_reduce("sum", values.size(), 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
+        CHECK(exclusive_scan(device, "scan", data.cview(), scanned.view()) == total);
+        CHECK(transform_reduce(device, "sum", values.size(), 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
               total_long);
     }
     std::vector<int> expected(values.size());
@@ -103,16 +102,16 @@ inline void check_scan_then_reduce() {
 
 // Stage timers: a timed stage reads a positive time, a stage not started reads 0, and read() starts
 // the next interval from 0 (the step's stats rely on all three).
-inline void check_stage_timers() {
+inline void check_stage_timers(const DeviceContext& device) {
     const std::vector<int> values = random_values(kPrimitiveCount, 29);
     DeviceArray<int> data, out(values.size());
     data.upload(values);
     const View<const int> d = data.cview();
     const View<int> o = out.view();
-    StageTimers timers(2);
+    StageTimers timers(device, 2);
     timers.start(0);
     for (int pass = 0; pass < 20; ++pass)
-        parallel_for("timed work", values.size(), [=] MW_HD(std::size_t i) { o[i] = d[i] * 3 + pass; });
+        parallel_for(device, "timed work", values.size(), [=] MW_HD(std::size_t i) { o[i] = d[i] * 3 + pass; });
     timers.stop(0);
     double ms[2] = {-1, -1};
     timers.read(ms);
@@ -125,22 +124,22 @@ inline void check_stage_timers() {
     CHECK(out.to_host()[5] == values[5] * 3 + 19);  // the timed work was done
 }
 
-inline void check_exclusive_scan() {
+inline void check_exclusive_scan(const DeviceContext& device) {
     const std::vector<int> values = random_values(kPrimitiveCount, 11);
     DeviceArray<int> data, scanned(values.size());
     data.upload(values);
-    const int total = exclusive_scan("scan", data.cview(), scanned.view());
+    const int total = exclusive_scan(device, "scan", data.cview(), scanned.view());
     std::vector<int> expected(values.size());
     std::exclusive_scan(values.begin(), values.end(), expected.begin(), 0);
     CHECK(scanned.to_host() == expected);
     CHECK(total == std::accumulate(values.begin(), values.end(), 0));
     // In place, as the neighbour lists scan their row sizes.
-    const int total_in_place = exclusive_scan("scan in place", data.cview(), data.view());
+    const int total_in_place = exclusive_scan(device, "scan in place", data.cview(), data.view());
     CHECK(data.to_host() == expected);
     CHECK(total_in_place == total);
 }
 
-inline void check_sort_pairs() {
+inline void check_sort_pairs(const DeviceContext& device) {
     const std::size_t n = kPrimitiveCount;
     std::mt19937 rng(13);
     std::vector<std::uint32_t> keys(n), order(n);
@@ -149,7 +148,7 @@ inline void check_sort_pairs() {
     DeviceArray<std::uint32_t> k_in, k_out(n), v_in, v_out(n);
     k_in.upload(keys);
     v_in.upload(order);
-    sort_pairs("sort", k_in.cview(), k_out.view(), v_in.cview(), v_out.view(), 13);
+    sort_pairs(device, "sort", k_in.cview(), k_out.view(), v_in.cview(), v_out.view(), 13);
     // Radix sorts are stable: equal keys keep their input order, which the permutation relies on
     // for reproducible runs.
     std::vector<std::uint32_t> expected_order = order;
@@ -166,12 +165,12 @@ inline void check_sort_pairs() {
         std::vector<std::uint32_t> noisy(n);
         for (std::size_t i = 0; i < n; ++i) noisy[i] = keys[i] | (std::uint32_t(rng()) << key_bits);
         k_in.upload(noisy);
-        sort_pairs("sort, noisy high bits", k_in.cview(), k_out.view(), v_in.cview(), v_out.view(), key_bits);
+        sort_pairs(device, "sort, noisy high bits", k_in.cview(), k_out.view(), v_in.cview(), v_out.view(), key_bits);
         CHECK_MESSAGE(v_out.to_host() == expected_order, "key_bits " << key_bits);
     }
 }
 
-inline void check_atomics() {
+inline void check_atomics(const DeviceContext& device) {
     // A histogram built by every index adding into a few bins at once.
     const std::vector<int> values = random_values(kPrimitiveCount, 17);
     const int bins = 7;
@@ -183,7 +182,7 @@ inline void check_atomics() {
     const View<const int> d = data.cview();
     const View<int> c = counts.view();
     const View<float> s = sums.view();
-    parallel_for("histogram", values.size(), [=] MW_HD(std::size_t i) {
+    parallel_for(device, "histogram", values.size(), [=] MW_HD(std::size_t i) {
         const int bin = (d[i] + 500) % bins;
         atomic_add(&c[bin], 1);
         atomic_add(&s[bin], 1.0f);  // whole numbers stay exact in float up to 2^24
@@ -195,13 +194,26 @@ inline void check_atomics() {
     for (int b = 0; b < bins; ++b) CHECK(float_sums[b] == float(expected[b]));
 }
 
-inline void check_memory_ledger() {
-    const auto before = memory_ledger().current.load();
+// A context's scratch grows with what its reductions and sorts needed, and belongs to it alone: a
+// second context starts empty and leaves the first's as it was.
+inline void check_context_scratch(const DeviceContext& device) {
+    const std::vector<int> values = random_values(kPrimitiveCount, 31);
+    DeviceArray<int> data;
+    data.upload(values);
+    const View<const int> d = data.cview();
+    const long total = std::accumulate(values.begin(), values.end(), 0L);
+    CHECK(transform_reduce(device, "sum", values.size(), 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
+          total);
+    const std::size_t held = device.scratch_bytes();
+    CHECK(held > 0);
     {
-        DeviceArray<double> big(1000);
-        CHECK(memory_ledger().current.load() - before >= std::int64_t(8000));
+        DeviceContext other;
+        CHECK(other.scratch_bytes() == 0);
+        CHECK(transform_reduce(other, "sum", 10, 0L, SumOp{}, [=] MW_HD(std::size_t i) { return long(d[i]); }) ==
+              std::accumulate(values.begin(), values.begin() + 10, 0L));
+        CHECK(device.scratch_bytes() == held);
     }
-    CHECK(memory_ledger().current.load() == before);
+    CHECK(device.scratch_bytes() == held);
 }
 
 }  // namespace mw::test

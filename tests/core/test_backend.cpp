@@ -1,6 +1,8 @@
 // The OpenMP backend's primitives against plain sequential answers (the same checks run on the
-// CUDA backend in tests/cuda_backend), its memory ledger, and the lifetime of its shared scratch.
+// CUDA backend in tests/cuda_backend), and what a device context keeps to itself.
 #include <doctest/doctest.h>
+
+#include <cstring>
 
 #include "backend/backend.hpp"
 #include "backend_primitives.hpp"
@@ -9,41 +11,49 @@
 using namespace mw;
 
 TEST_CASE("reductions, scan, sort and atomics agree with sequential answers") {
-    test::check_reductions();
-    test::check_exclusive_scan();
-    test::check_sort_pairs();
-    test::check_atomics();
+    const DeviceContext device;
+    test::check_reductions(device);
+    test::check_exclusive_scan(device);
+    test::check_sort_pairs(device);
+    test::check_atomics(device);
 }
 
 TEST_CASE("struct reductions, a scan and a reduction back to back, and stage timers") {
-    test::check_struct_reductions();
-    test::check_scan_then_reduce();
-    test::check_stage_timers();
+    const DeviceContext device;
+    test::check_struct_reductions(device);
+    test::check_scan_then_reduce(device);
+    test::check_stage_timers(device);
 }
 
-TEST_CASE("memory ledger follows allocations") { test::check_memory_ledger(); }
+TEST_CASE("a device context's scratch is its own") {
+    const DeviceContext device;
+    test::check_context_scratch(device);
+}
 
-// The sort's scratch is shared by the simulations of a process and freed with the last of them,
-// so that a simulation's device_bytes() is its own, not the largest of the process so far.
-TEST_CASE("the backend's shared scratch lives as long as its last simulation") {
+// Each simulation owns its device context: its memory figure is its own whatever else the
+// process runs, and two simulations stepped in turn take the steps each takes alone.
+TEST_CASE("two simulations in one process share no state") {
     const SimulationSetup small =
         test::fluid_in_box({0, 0, 0}, {0.3f, 0.3f, 0.3f}, {0, 0, 0}, {0.1f, 0.1f, 0.1f}, 0.02f, 0.001f);
     const SimulationSetup large =
         test::fluid_in_box({0, 0, 0}, {0.6f, 0.6f, 0.6f}, {0, 0, 0}, {0.4f, 0.4f, 0.4f}, 0.02f, 0.001f);
-    auto first = create_openmp_simulation(large, 0);
-    first->step();
-    const std::size_t large_scratch = backend_scratch_bytes();
-    CHECK(large_scratch > 0);
-    {
-        auto second = create_openmp_simulation(small, 0);
-        second->step();
-        CHECK(backend_scratch_bytes() == large_scratch);  // shared, and still the large one's
-    }
-    CHECK(backend_scratch_bytes() == large_scratch);  // the first still uses it
-    first.reset();
-    CHECK(backend_scratch_bytes() == 0);
     auto alone = create_openmp_simulation(small, 0);
-    alone->step();
-    CHECK(backend_scratch_bytes() > 0);
-    CHECK(backend_scratch_bytes() < large_scratch);  // sized for the small one alone
+    for (int k = 0; k < 5; ++k) alone->step();
+    const std::size_t small_bytes = alone->device_bytes();
+    HostParticles alone_particles;
+    alone->download(alone_particles);
+
+    auto first = create_openmp_simulation(large, 0);
+    auto second = create_openmp_simulation(small, 0);
+    for (int k = 0; k < 5; ++k) {
+        first->step();
+        second->step();
+    }
+    CHECK(second->device_bytes() == small_bytes);
+    CHECK(first->device_bytes() > small_bytes);
+    HostParticles paired;
+    second->download(paired);
+    CHECK(paired.position.size() == alone_particles.position.size());
+    CHECK(std::memcmp(paired.position.data(), alone_particles.position.data(),
+                      paired.position.size() * sizeof(Vec3)) == 0);
 }

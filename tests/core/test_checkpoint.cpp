@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "backend/backend_registry.hpp"
-#include "backend/errors.hpp"
+#include "simulation/factory.hpp"
+#include "common/errors.hpp"
 #include "test_setups.hpp"
 #include "tests/skip.hpp"
 

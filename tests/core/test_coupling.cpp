@@ -13,14 +13,13 @@
 #include <map>
 #include <string>
 
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 #include "tests/skip.hpp"
 
 using namespace mw;
 
 TEST_CASE("two-way coupling keeps the momentum of fluid thrown at a free cube, which one-way loses") {
-    const test::RestoreThreadCount restore;
     for (const SolidKind kind : {SolidKind::kRigid, SolidKind::kElastic}) {
         for (const auto lists : test::kGatherModes) {
             const std::string variant = std::string(kind == SolidKind::kRigid ? "rigid" : "elastic") + ", " +
@@ -159,7 +158,6 @@ Floating float_box(double density_ratio, Real r0, bool correction = false) {
 }  // namespace
 
 TEST_CASE("a rigid box floats: its draft follows Archimedes' law, less about one r0 of boundary") {
-    const test::RestoreThreadCount restore;
     const Real r0 = 0.02f;
     const double box_y = 0.12;
     const Floating light = float_box(0.3, r0), heavy = float_box(0.7, r0);
@@ -196,7 +194,6 @@ TEST_CASE("a rigid box floats with the velocity-position correction against it t
     // the twentieth session the virtual particle was built from the SBPs the fluid moved into
     // (the paper's set), which pushed fluid resting by the box's edges along the wrong face
     // (virtual_boundary.hpp): force 0.964, tilt 0.39 r0, top speed 1.98 m/s.
-    const test::RestoreThreadCount restore;
     const Real r0 = 0.02f;
     const double ratio = 0.5, box_y = 0.12, expected = ratio * box_y;
     const Floating f = float_box(ratio, r0, true);

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "algorithms/state_archive.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 #include "../skip.hpp"
 
@@ -63,7 +63,7 @@ TEST_CASE("an emitter releases a layer every r0 / speed, each where and as fast 
         const double t = sim->time();
         const long due = t < start ? 0 : std::min<long>(jet.layers, long(std::floor((t - start) / interval + 1e-9)) + 1);
         CAPTURE(step);
-        REQUIRE(sim->last_report().emitted == due * long(per_layer));
+        REQUIRE(sim->last_report().value("emitted") == due * long(per_layer));
         REQUIRE(sim->counts().by_type[kFluid] == due * long(per_layer));
         REQUIRE(sim->counts().by_type[kPending] == long(per_layer * jet.layers) - due * long(per_layer));
         REQUIRE(sim->last_report().lost_particles == 0);
@@ -98,7 +98,7 @@ TEST_CASE("a stream fills a tank to the height of the volume it released") {
     const long released = long(setup.emitters[0].layers * setup.emitters[0].offsets.size());
     REQUIRE(released == 1575);
     while (sim->time() < 2.0) sim->step();
-    CHECK(sim->last_report().emitted == released);
+    CHECK(sim->last_report().value("emitted") == released);
     CHECK(sim->last_report().lost_particles == 0);
     HostParticles p;
     sim->download(p);
@@ -118,10 +118,10 @@ TEST_CASE("a stream fills a tank to the height of the volume it released") {
 TEST_CASE("a checkpoint taken mid-stream resumes bitwise where the whole run ends") {
     const SimulationSetup setup = setup_of(kTank);
     const test::SplitRun run = test::run_split(setup, 150, 100);
-    MESSAGE(run.saved_report.emitted << " emitted at the checkpoint, " << run.whole_report.emitted << " at the end");
-    REQUIRE(run.saved_report.emitted > 0);
-    REQUIRE(run.whole_report.emitted > run.saved_report.emitted);
-    CHECK(run.resumed_report.emitted == run.whole_report.emitted);
+    MESSAGE(run.saved_report.value("emitted") << " emitted at the checkpoint, " << run.whole_report.value("emitted") << " at the end");
+    REQUIRE(run.saved_report.value("emitted") > 0);
+    REQUIRE(run.whole_report.value("emitted") > run.saved_report.value("emitted"));
+    CHECK(run.resumed_report.value("emitted") == run.whole_report.value("emitted"));
     CHECK(run.resumed_counts.by_type[kPending] == run.whole_counts.by_type[kPending]);
     CHECK(run.resumed.type == run.uninterrupted.type);
     CHECK(std::memcmp(run.resumed.position.data(), run.uninterrupted.position.data(),
@@ -149,8 +149,8 @@ TEST_CASE("CUDA: a stream fills a tank as on OpenMP") {
     // step 150), so after the impact only rounding is compared, and it is chaotic.
     const SimulationSetup setup = setup_of(kTank);
     const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 60);
-    REQUIRE(runs.openmp_report.emitted > 0);
-    CHECK(runs.cuda_report.emitted == runs.openmp_report.emitted);
+    REQUIRE(runs.openmp_report.value("emitted") > 0);
+    CHECK(runs.cuda_report.value("emitted") == runs.openmp_report.value("emitted"));
     CHECK(runs.cuda.type == runs.openmp.type);
     const double worst = test::largest_position_difference(runs.openmp, runs.cuda);
     MESSAGE("largest position difference " << worst << " m after 60 steps");

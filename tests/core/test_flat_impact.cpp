@@ -7,13 +7,12 @@
 #include <doctest/doctest.h>
 
 #include "algorithms/sph_kernels.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;
 
 TEST_CASE("a block dropped flat onto the floor: CFL mode retries the impact at smaller steps and gains no energy") {
-    const test::RestoreThreadCount restore;  // the one thread set below is for this test alone
     const Real r0 = 0.02f, width = 0.2f;
     // 0.4 m of water whose bottom starts 0.1 m above the floor: it lands at 1.4 m/s.
     SimulationSetup setup =

@@ -13,7 +13,7 @@
 #include <algorithm>
 #include <string>
 
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 #include "tests/skip.hpp"
 
@@ -54,7 +54,6 @@ struct ColumnOnSlab {
 }  // namespace
 
 TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydrostatic profile, no leak") {
-    const test::RestoreThreadCount restore;
     // Neighbour lists, what OpenMP runs by default (kAuto); grid gathers are held to this run below.
     ColumnOnSlab scene(SimulationParams::Lists::kOn);
     const Real r0 = ColumnOnSlab::r0, width = ColumnOnSlab::width, slab_top = ColumnOnSlab::slab_top;
@@ -121,7 +120,6 @@ TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydros
 // after 50 steps, 8.0e-4 r0 after 100 (7.7e-3 r0 after 200, as the sloshing amplifies them). A slab
 // missing from the grid's sums would let the column fall on: 2.5 r0 in 0.1 s of free fall.
 TEST_CASE("a water column on a pinned elastic slab: grid gathers follow neighbour lists through the landing") {
-    const test::RestoreThreadCount restore;
     const Real r0 = ColumnOnSlab::r0, slab_top = ColumnOnSlab::slab_top;
     const int steps = 100;
     const ColumnOnSlab with_lists(SimulationParams::Lists::kOn), with_grid(SimulationParams::Lists::kOff);

@@ -24,7 +24,7 @@
 #include <cstdlib>
 
 #include "../skip.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;
@@ -87,12 +87,12 @@ ContactResult run_contact(double fourier, int max_substeps, double time) {
     Bar bar = contact_bar(diffusivity, dt, max_substeps);
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(bar.setup, 0);
     sim->step();
-    const double first_content = sim->last_report().heat_content;
+    const double first_content = sim->last_report().value("heat_content");
     const HostParticles p = test::run_steps(*sim, steps - 1);
     const double t = sim->time();
     ContactResult r;
-    r.substeps = sim->last_report().heat_substeps;
-    r.heat_drift = std::fabs(sim->last_report().heat_content - first_content) / std::fabs(first_content);
+    r.substeps = sim->last_report().value("heat_substeps");
+    r.heat_drift = std::fabs(sim->last_report().value("heat_content") - first_content) / std::fabs(first_content);
     std::vector<double> near_d, near_temperature;
     r.lowest = 1e30;
     r.highest = -1e30;
@@ -227,7 +227,7 @@ TEST_CASE("heat flows from a hot solid into the fluid around it, within the two 
     const SimulationSetup setup = hot_box_in_pool(20, 80);
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
     sim->step();
-    const double first_content = sim->last_report().heat_content;
+    const double first_content = sim->last_report().value("heat_content");
     double previous_box = 80, previous_fluid = 20;
     for (int round = 0; round < 3; ++round) {
         const HostParticles p = test::run_steps(*sim, 20);
@@ -247,7 +247,7 @@ TEST_CASE("heat flows from a hot solid into the fluid around it, within the two 
         previous_box = box.mean();
         previous_fluid = fluid.mean();
         // Σ V ρc T: the walls are adiabatic, and every pair exchanges what it takes.
-        CHECK(std::fabs(sim->last_report().heat_content / first_content - 1) < 1e-6);
+        CHECK(std::fabs(sim->last_report().value("heat_content") / first_content - 1) < 1e-6);
     }
     // The mesh vertices (rendering only) keep their initial temperature.
     HostParticles p;
@@ -265,14 +265,14 @@ TEST_CASE("a solid with half the fluid's heat capacity cools faster and warms th
     auto run = [](double box_capacity) {
         const std::unique_ptr<Simulation> sim = create_openmp_simulation(hot_box_in_pool(20, 80, box_capacity), 0);
         sim->step();
-        const double first_content = sim->last_report().heat_content;
+        const double first_content = sim->last_report().value("heat_content");
         const HostParticles p = test::run_steps(*sim, 40);
         TemperatureRange box, fluid;
         for (std::size_t i = 0; i < p.position.size(); ++i) {
             if (p.type[i] == kFluid) fluid.add(double(p.temperature[i]));
             if (p.type[i] == kSurfaceBoundary || p.type[i] == kInnerBoundary) box.add(double(p.temperature[i]));
         }
-        return Means{box.mean(), fluid.mean(), std::fabs(sim->last_report().heat_content / first_content - 1)};
+        return Means{box.mean(), fluid.mean(), std::fabs(sim->last_report().value("heat_content") / first_content - 1)};
     };
     const Means same = run(1), half = run(0.5);
     MESSAGE("after 41 steps: box " << same.box << " against " << half.box << " at half the capacity, fluid "
@@ -305,7 +305,7 @@ TEST_CASE("two solids conduct heat to each other without any fluid") {
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
     REQUIRE(sim->counts().by_type[kFluid] == 0);
     sim->step();
-    const double first_content = sim->last_report().heat_content;
+    const double first_content = sim->last_report().value("heat_content");
     const HostParticles p = test::run_steps(*sim, 30);
     TemperatureRange hot, cold;
     for (std::size_t i = 0; i < p.position.size(); ++i) {
@@ -313,12 +313,12 @@ TEST_CASE("two solids conduct heat to each other without any fluid") {
         (i < hot_end ? hot : cold).add(double(p.temperature[i]));
     }
     MESSAGE("after 31 steps: hot box mean " << hot.mean() << ", cold box mean " << cold.mean() << ", drift "
-                                            << std::fabs(sim->last_report().heat_content / first_content - 1));
+                                            << std::fabs(sim->last_report().value("heat_content") / first_content - 1));
     CHECK(hot.mean() < 59);
     CHECK(cold.mean() > 11);
     CHECK(std::min(hot.lowest, cold.lowest) >= 10 - 1e-3);
     CHECK(std::max(hot.highest, cold.highest) <= 60 + 1e-3);
-    CHECK(std::fabs(sim->last_report().heat_content / first_content - 1) < 1e-6);
+    CHECK(std::fabs(sim->last_report().value("heat_content") / first_content - 1) < 1e-6);
 }
 
 TEST_CASE("temperatures are part of the saved state: a resumed run ends bitwise where the whole one does") {
@@ -366,7 +366,7 @@ TEST_CASE("CUDA and OpenMP conduct heat alike") {
     for (std::size_t i = 0; i < runs.openmp.temperature.size(); ++i)
         worst = std::max(worst, std::fabs(double(runs.openmp.temperature[i]) - double(runs.cuda.temperature[i])));
     CHECK(worst < 1e-3 * 60);
-    CHECK(runs.openmp_report.heat_substeps == runs.cuda_report.heat_substeps);
+    CHECK(runs.openmp_report.value("heat_substeps") == runs.cuda_report.value("heat_substeps"));
 }
 
 TEST_CASE("heat diagnostics" * doctest::skip(std::getenv("MW_HEAT_PROBE") == nullptr)) {

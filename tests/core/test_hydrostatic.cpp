@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "algorithms/sph_kernels.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;

@@ -12,7 +12,7 @@
 #include <cmath>
 #include <memory>
 
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 #include "tests/skip.hpp"
 
@@ -93,7 +93,6 @@ Hanging hang(Real eta, double seconds, int numbered_after = 0) {
 }  // namespace
 
 TEST_CASE("interface tension holds a fluid layer under a plate, which falls freely without it") {
-    const test::RestoreThreadCount restore;
     // Free fall as symplectic Euler takes it, n steps of Δt: g Δt² n (n + 1) / 2 (0.1982 m for
     // 100 steps of 2 ms, against g t²/2 = 0.1962 m).
     const int steps = 100;
@@ -124,7 +123,6 @@ TEST_CASE("interface tension reaches an object numbered after static boxes, as s
 }
 
 TEST_CASE("interface tension keeps the momentum of fluid thrown at a free cube") {
-    const test::RestoreThreadCount restore;
     test::CubeThrow thrown(SolidKind::kElastic, 2.0f, 0.001f);
     thrown.setup.params.two_way_coupling = true;
     thrown.setup.solids[0].interface_tension = 0.2f;

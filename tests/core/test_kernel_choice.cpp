@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;

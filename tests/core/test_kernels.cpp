@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "algorithms/neighbor_grid.hpp"
+#include "algorithms/boundary_volumes.hpp"
 #include "algorithms/pcisph.hpp"
 #include "algorithms/pcisph_delta.hpp"
 #include "algorithms/sph_kernels.hpp"
@@ -122,7 +123,8 @@ ViscosityRun run_viscosity(const std::vector<Vec3>& fluid, const std::vector<Vec
     std::fill(type.begin() + nf, type.end(), std::uint8_t(kStaticBoundary));
     std::vector<std::uint32_t> id(n);
     std::iota(id.begin(), id.end(), 0u);
-    ParticleStore store;
+    const DeviceContext device;
+    ParticleStore store(device);
     store.resize(n, nf);
     store.id.upload(id);
     store.position.upload(position);
@@ -136,7 +138,7 @@ ViscosityRun run_viscosity(const std::vector<Vec3>& fluid, const std::vector<Vec
         hi = Vec3{std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
     }
     const Real h = c.kernel.h;
-    NeighborGrid grid;
+    NeighborGrid grid(device);
     grid.configure(Vec3{lo.x - h, lo.y - h, lo.z - h}, Vec3{hi.x + h, hi.y + h, hi.z + h}, h, CellOrdering::kZOrder);
     grid.build_static(store);
     const GroupRanges ranges = grid.build(store);
@@ -144,9 +146,9 @@ ViscosityRun run_viscosity(const std::vector<Vec3>& fluid, const std::vector<Vec
     DeviceArray<Real> volume(n);
     volume.fill(Real(0));
     if (!walls.empty())
-        compute_boundary_volumes(grid.view(), store.position.cview(), volume.view(), nf, walls.size(), false, c.kernel);
+        compute_boundary_volumes(device, grid.view(), store.position.cview(), volume.view(), nf, walls.size(), false, c.kernel);
     DeviceArray<Vec3> acceleration(nf);
-    compute_viscosity_acceleration(grid.view(), nf, store.position.cview(), store.velocity.cview(),
+    compute_viscosity_acceleration(device, grid.view(), nf, store.position.cview(), store.velocity.cview(),
                                    store.density.cview(), volume.cview(), acceleration.view(), c);
     ViscosityRun out;
     out.position = store.position.to_host();

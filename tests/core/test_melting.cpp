@@ -8,7 +8,7 @@
 
 #include "../skip.hpp"
 #include "algorithms/lsm_regions.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;
@@ -159,7 +159,7 @@ TEST_CASE("an object above its melting point melts from the outside in, one latt
         const long solid_before = total - melted;
         const long solid_after = inner > 0 ? inner * inner * inner : 0;
         const HostParticles p = test::run_steps(*sim, 1);
-        melted = sim->last_report().melted;
+        melted = sim->last_report().value("melted");
         INFO("step " << step);
         CHECK(melted == total - solid_after);
         CHECK(count_type(p, kFluid) == total - solid_after);
@@ -185,7 +185,7 @@ TEST_CASE("an object above its melting point melts from the outside in, one latt
     // Everything melted: the solid stages have nothing left, and the steps go on.
     test::run_steps(*sim, 3);
     CHECK(sim->counts().by_type[kFluid] == total);
-    CHECK(sim->last_report().melted == total);
+    CHECK(sim->last_report().value("melted") == total);
 }
 
 TEST_CASE("latent heat: an object at its melting point absorbs heat without warming, and the heat content counts it") {
@@ -202,7 +202,7 @@ TEST_CASE("latent heat: an object at its melting point absorbs heat without warm
     for (std::size_t i = 0; i < setup.position.size(); ++i) setup.temperature.push_back(Real(setup.object[i] < 0 ? 40 : 0));
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
     sim->step();
-    const double first = sim->last_report().heat_content;
+    const double first = sim->last_report().value("heat_content");
     const HostParticles p = test::run_steps(*sim, 40);
     double fluid_sum = 0, solid_highest = -1e30;
     long fluid = 0;
@@ -214,10 +214,10 @@ TEST_CASE("latent heat: an object at its melting point absorbs heat without warm
             solid_highest = std::max(solid_highest, double(p.temperature[i]));
         }
     }
-    const double drift = std::fabs(sim->last_report().heat_content / first - 1);
+    const double drift = std::fabs(sim->last_report().value("heat_content") / first - 1);
     MESSAGE("fluid mean " << fluid_sum / double(fluid) << " °C, solid highest " << solid_highest << " °C, heat drift "
                           << drift);
-    CHECK(sim->last_report().melted == 0);
+    CHECK(sim->last_report().value("melted") == 0);
     CHECK(solid_highest <= 1e-4);             // held at the melting point
     CHECK(fluid_sum / double(fluid) < 39.9);  // the water gave heat ...
     CHECK(drift < 1e-6);                      // ... which the cube holds as latent heat
@@ -248,7 +248,7 @@ TEST_CASE("an ice cube in warm water melts gradually, and what melts joins the w
     long previous = 0, steps_with_melting = 0;
     for (int step = 0; step < 60; ++step) {
         sim->step();
-        const long melted = sim->last_report().melted;
+        const long melted = sim->last_report().value("melted");
         REQUIRE(melted >= previous);
         steps_with_melting += melted > previous;
         previous = melted;
@@ -266,10 +266,10 @@ TEST_CASE("an ice cube in warm water melts gradually, and what melts joins the w
 
 TEST_CASE("a checkpoint taken mid-melt resumes bitwise where the whole run ends") {
     const test::SplitRun run = test::run_split(ice_in_warm_water(), 30, 20);
-    MESSAGE(run.saved_report.melted << " melted at the checkpoint, " << run.whole_report.melted << " at the end");
-    REQUIRE(run.saved_report.melted > 0);
-    REQUIRE(run.whole_report.melted > run.saved_report.melted);  // melting went on after it
-    CHECK(run.resumed_report.melted == run.whole_report.melted);
+    MESSAGE(run.saved_report.value("melted") << " melted at the checkpoint, " << run.whole_report.value("melted") << " at the end");
+    REQUIRE(run.saved_report.value("melted") > 0);
+    REQUIRE(run.whole_report.value("melted") > run.saved_report.value("melted"));  // melting went on after it
+    CHECK(run.resumed_report.value("melted") == run.whole_report.value("melted"));
     CHECK(run.resumed.type == run.uninterrupted.type);
     CHECK(std::memcmp(run.resumed.position.data(), run.uninterrupted.position.data(),
                       run.resumed.position.size() * sizeof(Vec3)) == 0);
@@ -300,7 +300,7 @@ TEST_CASE("CUDA: an object melts layer by layer as on OpenMP") {
     test::add_box_solid(setup, Vec3d(0.13, 0.13, 0.13), Vec3d(0.15, 0.15, 0.15), melting_solid(0, 0), Vec3{0, 0, 0});
     for (std::size_t i = 0; i < setup.position.size(); ++i) setup.temperature.push_back(Real(setup.object[i] < 0 ? 0 : 30));
     const test::OpenmpAndCuda both = test::run_openmp_and_cuda(setup, 2);
-    CHECK(both.cuda_report.melted == both.openmp_report.melted);
+    CHECK(both.cuda_report.value("melted") == both.openmp_report.value("melted"));
     CHECK(both.cuda.type == both.openmp.type);
     const double moved = test::largest_position_difference(both.openmp, both.cuda);
     MESSAGE("largest position difference " << moved << " m");

@@ -16,7 +16,7 @@
 #include "algorithms/wall_contact.hpp"
 #include "apps/scene.hpp"
 #include "apps/scene_builder.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "test_setups.hpp"
 #include "tests/skip.hpp"

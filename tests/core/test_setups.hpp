@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "algorithms/state_archive.hpp"
 #include "algorithms/sph_kernels.hpp"
 #include "apps/scene_builder.hpp"
 #include "backend/backend.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/kdtree.hpp"
 #include "sampling/procedural_meshes.hpp"
@@ -88,14 +88,6 @@ inline long add_box_solid(SimulationSetup& setup, Vec3d size, Vec3d centre, cons
     const std::vector<std::uint8_t> removed = carve_fluid(setup, Real(kFluidClearance) * r0, {}, before);
     return std::count(removed.begin(), removed.end(), 1);
 }
-
-// create_openmp_simulation(setup, n) sets the thread count of the whole process (omp_set_num_threads)
-// and n = 0 keeps whatever it is, so a test that picks a thread count puts the previous one back:
-// otherwise every later test in the program would run on that count.
-struct RestoreThreadCount {
-    const int saved = openmp_backend::thread_count();
-    ~RestoreThreadCount() { openmp_backend::set_threads(saved); }
-};
 
 // Steps `sim` `steps` times and returns its particles.
 inline HostParticles run_steps(Simulation& sim, int steps) {

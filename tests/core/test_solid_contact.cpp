@@ -13,7 +13,7 @@
 #include <cmath>
 #include <string>
 
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;
@@ -95,7 +95,6 @@ std::string describe(const ThrowOutcome& o) {
 }  // namespace
 
 TEST_CASE("the velocity-position correction keeps fluid thrown at twice the CFL step out of a rigid cube") {
-    const test::RestoreThreadCount restore;
     const Real speed = 8, dt = 0.002f;
     const int steps = 20;  // 40 ms: the fluid has hit the cube and spread over its face
     const ThrowOutcome without = throw_at_cube(SolidKind::kRigid, true, false, speed, dt, steps);
@@ -119,7 +118,6 @@ TEST_CASE("the velocity-position correction keeps fluid thrown at twice the CFL 
 }
 
 TEST_CASE("the velocity-position correction keeps the momentum of fluid thrown at an elastic cube") {
-    const test::RestoreThreadCount restore;
     // At the CFL step (4 m/s, Δt = 2 ms: 0.4 r0 a step), so that the impact itself makes no energy.
     const ThrowOutcome o = throw_at_cube(SolidKind::kElastic, true, true, 4, 0.002f, 40);
     MESSAGE("elastic, two-way, correction: " << describe(o));

@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <string>
 
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;

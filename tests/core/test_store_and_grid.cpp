@@ -13,7 +13,8 @@
 using namespace mw;
 
 TEST_CASE("one permutation keeps every field of a particle together") {
-    ParticleStore store;
+    const DeviceContext device;
+    ParticleStore store(device);
     DeviceArray<double>& extra = store.add<double>("extra", FieldLife::kPersistent);
     const std::size_t n = 5000;
     store.resize(n, n);
@@ -120,10 +121,11 @@ void load_fluid_points(ParticleStore& store, const std::vector<Vec3>& points) {
 std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<Vec3>& points, Vec3 lo, Vec3 hi, Real h,
                                                             CellOrdering ordering, int cells_per_h,
                                                             bool with_lists = false) {
-    ParticleStore store;
+    const DeviceContext device;
+    ParticleStore store(device);
     const std::size_t n = points.size();
     load_fluid_points(store, points);
-    NeighborGrid grid;
+    NeighborGrid grid(device);
     grid.configure(lo, hi, h, ordering, cells_per_h);
     const GroupRanges ranges = grid.build(store);
     REQUIRE(ranges.fluid_end == n);
@@ -139,7 +141,7 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> grid_pairs(const std::vector<V
         return pairs;
     }
     // The CSR lists the PCISPH gathers read on CPU cores (branch-free fill), radius h.
-    NeighborList lists;
+    NeighborList lists(device);
     DeviceArray<std::uint32_t> row_counts(n);
     row_counts.fill(0);
     lists.build(view, n, store.position.cview(), h, row_counts.view());
@@ -186,13 +188,14 @@ TEST_CASE("neighbour lists stay exact when counts grow past their slack") {
     std::vector<Vec3> points;
     for (int i = 0; i < 5000; ++i) points.push_back({unit(rng), unit(rng) * Real(0.5), unit(rng) * Real(0.3)});
     const std::size_t n = points.size();
-    ParticleStore store;
+    const DeviceContext device;
+    ParticleStore store(device);
     load_fluid_points(store, points);
-    NeighborGrid grid;
+    NeighborGrid grid(device);
     grid.configure({-h, -h, -h}, {1 + h, Real(0.5) + h, Real(0.3) + h}, h, CellOrdering::kZOrder);
     DeviceArray<std::uint32_t>& row_counts = store.add<std::uint32_t>("neighbor_count", FieldLife::kPersistent);
     row_counts.fill(0);
-    NeighborList lists;
+    NeighborList lists(device);
 
     // 1. No counts yet: every row overflows its slack, and the second fill makes it exact.
     grid.build(store);
@@ -239,12 +242,13 @@ TEST_CASE("neighbour lists stay exact when counts grow past their slack") {
 }
 
 TEST_CASE("particles outside the grid are set aside, not lost silently") {
-    ParticleStore store;
+    const DeviceContext device;
+    ParticleStore store(device);
     std::vector<Vec3> points = {{0.5f, 0.5f, 0.5f}, {5.f, 0.5f, 0.5f}, {0.4f, 0.5f, 0.5f}};
     store.resize(points.size(), points.size());
     store.position.upload(points);
     store.type.fill(kFluid);
-    NeighborGrid grid;
+    NeighborGrid grid(device);
     grid.configure({0, 0, 0}, {1, 1, 1}, 0.1f, CellOrdering::kZOrder);
     const GroupRanges ranges = grid.build(store);
     CHECK(ranges.fluid_end == 2);

@@ -29,7 +29,7 @@
 
 #include <cmath>
 
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
 using namespace mw;
@@ -54,7 +54,6 @@ double shear_amplitude(const HostParticles& p, Vec3 origin, double length, doubl
 // Runs the mode for 0.5 s with D = depth_in_r0 · r0 between the side walls; returns the decay rate
 // relative to the analytic one, minus 1.
 double decay_rate_deviation(int depth_in_r0) {
-    const test::RestoreThreadCount restore;
     const Real r0 = 0.02f, height = 0.2f, length = 1.0f, depth = Real(depth_in_r0) * r0, amplitude = 0.05f;
     const Real mu = 4, dt = 0.002f;  // ν = 4e-3 m²/s: the mode decays by 39% in 0.5 s
     // The box off the origin: a reflection's offset is twice its face's position.

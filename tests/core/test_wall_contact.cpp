@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "algorithms/wall_contact.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/fluid_clearance.hpp"
 #include "sampling/wall_gap.hpp"

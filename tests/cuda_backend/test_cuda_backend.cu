@@ -15,31 +15,37 @@ bool gpu_present() {
     MW_SKIP("no usable CUDA device (" << mw::unavailable_reason() << ")");
     return false;
 }
+// A context per case, made only where a GPU is present.
+#define MW_WITH_DEVICE(check)            \
+    if (gpu_present()) {                 \
+        const mw::DeviceContext device;  \
+        mw::test::check(device);         \
+    }
 }  // namespace
 
 TEST_CASE("CUDA reductions agree with sequential answers") {
-    if (gpu_present()) mw::test::check_reductions();
+    MW_WITH_DEVICE(check_reductions)
 }
 TEST_CASE("CUDA exclusive scan agrees with a sequential scan, also in place") {
-    if (gpu_present()) mw::test::check_exclusive_scan();
+    MW_WITH_DEVICE(check_exclusive_scan)
 }
 TEST_CASE("CUDA radix sort is a stable sort") {
-    if (gpu_present()) mw::test::check_sort_pairs();
+    MW_WITH_DEVICE(check_sort_pairs)
 }
 TEST_CASE("CUDA atomics lose no update") {
-    if (gpu_present()) mw::test::check_atomics();
+    MW_WITH_DEVICE(check_atomics)
 }
-TEST_CASE("CUDA memory ledger follows allocations") {
-    if (gpu_present()) mw::test::check_memory_ledger();
+TEST_CASE("CUDA: a device context's scratch is its own") {
+    MW_WITH_DEVICE(check_context_scratch)
 }
 TEST_CASE("CUDA struct reductions, at every size from empty to many blocks") {
-    if (gpu_present()) mw::test::check_struct_reductions();
+    MW_WITH_DEVICE(check_struct_reductions)
 }
 TEST_CASE("CUDA scan and reduction back to back (one pinned result buffer)") {
-    if (gpu_present()) mw::test::check_scan_then_reduce();
+    MW_WITH_DEVICE(check_scan_then_reduce)
 }
 TEST_CASE("CUDA stage timers (events)") {
-    if (gpu_present()) mw::test::check_stage_timers();
+    MW_WITH_DEVICE(check_stage_timers)
 }
 // An allocation larger than the device is a DeviceError that says so (the command line adds the
 // scene's estimate to it), and leaves the device usable.
@@ -53,7 +59,8 @@ TEST_CASE("CUDA out of memory is a clear error, and the device stays usable") {
         message = e.what();
     }
     CHECK(message.find("out of GPU memory") != std::string::npos);
-    mw::test::check_reductions();
+    const mw::DeviceContext device;
+    mw::test::check_reductions(device);
 }
 
 MW_TEST_MAIN

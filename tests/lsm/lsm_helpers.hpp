@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "apps/scene_builder.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 #include "sampling/procedural_meshes.hpp"
 
 namespace lsm_test {

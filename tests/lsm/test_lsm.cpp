@@ -74,10 +74,10 @@ RigidFit fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& x0, cons
 // normals, chunked sums). `serial_limit` is SolidBodies::init's: the region size above which
 // sums are chunked.
 struct DirectSolids {
-    openmp_backend::ParticleStore store;
-    openmp_backend::SolidBodies bodies;
+    openmp_backend::DeviceContext device{1};  // as make_openmp: the suite runs beside other jobs on 2 cores
+    openmp_backend::ParticleStore store{device};
+    openmp_backend::SolidBodies bodies{device};
     explicit DirectSolids(const SimulationSetup& s, std::size_t serial_limit = kRegionSerialMembers) {
-        openmp_backend::set_threads(1);  // as make_openmp: the suite runs beside other jobs on 2 cores
         const std::size_t n = s.position.size();
         store.resize(n, n);
         std::vector<std::uint32_t> order(n);

@@ -7,7 +7,7 @@
 
 #include <doctest/doctest.h>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "tests/skip.hpp"
 
 namespace mwtest {

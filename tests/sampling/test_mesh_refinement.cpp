@@ -6,7 +6,7 @@
 
 #include <doctest/doctest.h>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "sampling/mesh_refinement.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/solid_sample.hpp"

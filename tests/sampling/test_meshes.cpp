@@ -6,7 +6,7 @@
 
 #include <doctest/doctest.h>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "sampling/mesh.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"

@@ -8,7 +8,7 @@
 
 #include <doctest/doctest.h>
 
-#include "backend/errors.hpp"
+#include "common/errors.hpp"
 #include "sampling/inside_outside.hpp"
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"

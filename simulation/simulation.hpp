@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <limits>
 #include <string>
 #include <vector>
@@ -223,15 +224,23 @@ struct StepReport {
     long lost_particles = 0;   // fluid particles that have left the domain so far
     double solid_kinetic_energy = 0;  // J over the IBPs of moving solids
     double solid_max_speed = 0;       // m/s over the same
-    int heat_substeps = 0;  // the heat stage's sub-steps this step (heat.hpp); 0 without it
-    double heat_content = 0;  // Σ M T over the conducting particles after the step, J (T in °C; heat.hpp); 0 without it
-    long melted = 0;  // particles melted since the scene started (melting.hpp); 0 without a melting object
-    long emitted = 0;  // particles emitted since the scene started (emitter.hpp); 0 without an emitter
     int retries = 0;  // CFL mode: times this step was halved because PCISPH diverged or ran out of iterations
     bool diverged = false;  // the step's last PCISPH try still diverged (no retry left, or fixed mode)
     bool unconverged = false;  // the last try ran out of iterations above η (or eta_max), without diverging
-    std::vector<double> stage_ms;  // per stage, same order as stage_names(); 0 for a stage not run
+    // The modules' own columns, in the plan's order (heat: heat_substeps and heat_content, the heat
+    // Σ M T in J with T in °C; melting: melted, particles melted since the start; emitters:
+    // emitted, particles emitted since the start), and their values after the step.
+    std::vector<std::string> column_names;
+    std::vector<double> columns;
+    std::vector<double> stage_ms;  // per stage, same order as stage_names()
     double total_ms = 0;
+
+    // The value of column `name`; throws std::out_of_range when the scene has no such column.
+    double value(const std::string& name) const {
+        for (std::size_t k = 0; k < column_names.size() && k < columns.size(); ++k)
+            if (column_names[k] == name) return columns[k];
+        throw std::out_of_range("no step report column " + name);
+    }
 };
 
 struct ParticleCounts {

@@ -1,17 +1,16 @@
-// The CUDA instantiation of the algorithms, for both kernels, and the backend's factory.
+// The CUDA instantiation of the simulation, for both kernels, and the backend's factory.
 //
 // Both kernels are instantiated in this one translation unit, unlike OpenMP's two files. nvcc
 // gives each translation unit its own copy (in an anonymous namespace) of the function pointers
 // behind an extended __host__ __device__ lambda, and a lambda written in a non-template function
 // (build_slot_map, fill_cell_ranges, ...) has the same type in every unit, so the linker keeps one
 // unit's parallel_for<that lambda> while the lambda object may be made in the other: its copy is
-// then called through a null pointer. With the Wendland C2 simulation in a file of its own, a
-// Wendland scene with solids crashed at its first such launch on an H200 (2026-12-04), unless a
-// cubic spline simulation had run earlier in the same process. tests/cuda_lambda_units.sh keeps
-// any two CUDA units from sharing such a lambda.
+// then called through a null pointer (a Wendland C2 scene with solids, compiled in a unit of its
+// own, crashed so at its first such launch unless a cubic spline simulation had run before it in
+// the process). tests/cuda_lambda_units.sh keeps any two CUDA units from sharing such a lambda.
 #define MW_BACKEND_CUDA
-#include "algorithms/time_step.hpp"
-#include "backend/backend_registry.hpp"
+#include "simulation/backend_simulation.hpp"
+#include "simulation/factory.hpp"
 
 namespace mw {
 
@@ -19,7 +18,7 @@ BackendInfo cuda_backend_info() {
     const std::string why_not = cuda_backend::unavailable_reason();
     const bool available = why_not.empty();
     return BackendInfo{"cuda", true, available,
-                       available ? cuda_backend::device_description() : "compiled, but " + why_not,
+                       available ? cuda_backend::DeviceContext(0).description() : "compiled, but " + why_not,
                        cuda_backend::kPrefersNeighborLists};
 }
 
@@ -27,16 +26,16 @@ std::unique_ptr<Simulation> create_cuda_simulation(const SimulationSetup& setup)
     const std::string why_not = cuda_backend::unavailable_reason();
     if (!why_not.empty()) throw DeviceError("the CUDA backend was requested but is unusable: " + why_not);
     // The command line adds the scene's particle count and memory estimate to a DeviceError.
-    return cuda_backend::make_simulation(setup);
+    return cuda_backend::make_simulation(setup, 0);
 }
 
 }  // namespace mw
 
 MW_BACKEND_BEGIN
-std::unique_ptr<Simulation> make_cubic_spline_simulation(const SimulationSetup& setup) {
-    return std::make_unique<BackendSimulation<CubicSpline3D>>(setup);
+std::unique_ptr<Simulation> make_cubic_spline_simulation(const SimulationSetup& setup, int threads) {
+    return std::make_unique<BackendSimulation<CubicSpline3D>>(setup, threads);
 }
-std::unique_ptr<Simulation> make_wendland_c2_simulation(const SimulationSetup& setup) {
-    return std::make_unique<BackendSimulation<WendlandC2_3D>>(setup);
+std::unique_ptr<Simulation> make_wendland_c2_simulation(const SimulationSetup& setup, int threads) {
+    return std::make_unique<BackendSimulation<WendlandC2_3D>>(setup, threads);
 }
 MW_BACKEND_END

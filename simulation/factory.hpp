@@ -1,11 +1,12 @@
 // What the program was built with, and the factories that create a simulation on each backend.
-// Host-only; defined in backend/openmp/, backend/cuda/ (or backend/cuda_absent.cpp).
+// Host-only; defined in simulation/instantiate_openmp.cpp, simulation/instantiate_cuda.cu (or
+// simulation/cuda_absent.cpp).
 #pragma once
 #include <memory>
 #include <string>
 
-#include "algorithms/simulation.hpp"
-#include "backend/errors.hpp"
+#include "simulation/simulation.hpp"
+#include "common/errors.hpp"
 
 namespace mw {
 struct BackendInfo {

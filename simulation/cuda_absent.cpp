@@ -1,5 +1,5 @@
 // Linked when the CUDA backend was not compiled: the program still answers what it has.
-#include "backend/backend_registry.hpp"
+#include "simulation/factory.hpp"
 
 namespace mw {
 // prefers_neighbor_lists: the compiled backend's default (grid gathers), so that `info --backend

@@ -1,0 +1,74 @@
+// The boundary volumes module: Akinci's volume V_b of every boundary particle (Akinci et al.
+// 2012), which weighs its share in the fluid's density and forces. The static boundary's are
+// computed once at set-up; the moving solids' every step (stage "solid_volumes"), as their
+// particles spread and bunch up.
+#pragma once
+#include "algorithms/module.hpp"
+
+MW_BACKEND_BEGIN
+
+// Akinci boundary volume V_b = 1 / Σ_k W(x_b - x_k) over boundary neighbours k (b included), for
+// particles [first, first + count). Static particles see static neighbours only (computed once);
+// moving solids see moving solids and static walls. Branch-free terms (W_r2 is 0 out of range by
+// itself), as in the PCISPH sums: a boundary particle's neighbourhood is dense (walls at r0/2), and
+// whether a candidate is in range is unpredictable.
+template <class Kernel>
+void compute_boundary_volumes(const DeviceContext& device, GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
+                              std::size_t count, bool moving, Kernel kernel) {
+    parallel_for(device, "boundary_volume", count, [=] MW_HD(std::size_t k) {
+        const std::size_t b = first + k;
+        const Vec3 xb = position[b];
+        Real sum = 0;
+        auto add = [&](std::uint32_t j) { sum += kernel.W_r2(norm2(xb - position[j])); };
+        grid.for_each_static(xb, add);
+        if (moving) grid.for_each_solid(xb, add);
+        volume[b] = sum > Real(0) ? Real(1) / sum : Real(0);
+    });
+}
+
+template <class Kernel>
+class BoundaryVolumes final : public Module {
+   public:
+    // `moving_solids`: the scene has elastic or rigid objects; `heat`: it conducts heat, which
+    // reads the solids' volumes even without fluid.
+    BoundaryVolumes(SimulationState<Kernel>& state, bool moving_solids, bool heat)
+        : state_(state), moving_solids_(moving_solids), per_step_(moving_solids && state.has_fluid) {
+        const ParticleStore& store = state.store;
+        // Only fluid next to boundary particles reads them: without fluid (but for heat), or
+        // without any boundary particle, they are neither stored nor computed. Indexed like the
+        // store (fluid entries unused), so that a particle changing type (melting) needs no
+        // re-indexing.
+        const bool for_fluid = state.has_fluid && (store.static_count() > 0 || moving_solids);
+        if (for_fluid || (heat && moving_solids)) volume_.resize(store.size());
+    }
+
+    // The static boundary's volumes, once: they see static neighbours only.
+    void start(const StepContext& first) override {
+        const ParticleStore& store = state_.store;
+        if (state_.has_fluid && store.static_count() > 0)
+            compute_boundary_volumes(state_.device, first.neighbors.grid, store.position.cview(), volume_.view(),
+                                     store.moving_count(), store.static_count(), false, state_.fluid.kernel);
+    }
+
+    void bind(StepPlan& plan) override {
+        if (per_step_) plan.bind("solid_volumes", [this](StepContext& step) { update_moving(step.neighbors.grid, step.ranges); });
+    }
+
+    // The moving solids' boundary particles' volumes, over the current grid.
+    void update_moving(const GridView& grid, const GroupRanges& ranges) {
+        compute_boundary_volumes(state_.device, grid, state_.store.position.cview(), volume_.view(), ranges.fluid_end,
+                                 ranges.solid_end - ranges.fluid_end, true, state_.fluid.kernel);
+    }
+    bool moving_solids() const { return moving_solids_; }
+    // Whether the step keeps them current (fluid and moving solids).
+    bool updated_every_step() const { return per_step_; }
+    View<const Real> volumes() const { return volume_.cview(); }
+    std::size_t bytes() const override { return volume_.bytes(); }
+
+   private:
+    SimulationState<Kernel>& state_;
+    bool moving_solids_ = false, per_step_ = false;
+    DeviceArray<Real> volume_;  // V_b, indexed like the store
+};
+
+MW_BACKEND_END
