@@ -19,11 +19,11 @@ class NeighborSearch final : public Module {
         : state_(state), grid_(state.device), lists_(state.device), arriving_(arriving) {
         const SimulationParams& params = state.params;
         const Real h = state.fluid.kernel.h;
-        grid_.configure(Vec3{lo.x - h, lo.y - h, lo.z - h}, Vec3{hi.x + h, hi.y + h, hi.z + h}, h, params.ordering,
-                        params.cells_per_support);
-        use_lists_ = state.has_fluid && (params.neighbor_lists == SimulationParams::Lists::kAuto
+        grid_.configure(Vec3{lo.x - h, lo.y - h, lo.z - h}, Vec3{hi.x + h, hi.y + h, hi.z + h}, h, params.neighbors.ordering,
+                        params.neighbors.cells_per_support);
+        use_lists_ = state.has_fluid && (params.neighbors.lists == NeighborParams::Lists::kAuto
                                              ? kPrefersNeighborLists
-                                             : params.neighbor_lists == SimulationParams::Lists::kOn);
+                                             : params.neighbors.lists == NeighborParams::Lists::kOn);
         if (use_lists_) {
             // Registered before the first sort, so that it travels with the particles from the
             // start; 0 makes the first build lay its rows out from exact counts (one second fill).

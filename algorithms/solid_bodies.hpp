@@ -147,7 +147,7 @@ class SolidBodies final : public Module {
             std::find(setup.type.begin(), setup.type.end(), std::uint8_t(kFluid)) != setup.type.end() ||
             std::any_of(setup.solids.begin(), setup.solids.end(), [](const SolidSetup& o) { return o.melts(); }) ||
             !setup.emitters.empty();
-        if (setup.params.two_way_coupling && any_fluid) {
+        if (setup.params.coupling.two_way && any_fluid) {
             const SurfaceShares shares = surface_shares(L);
             share_offsets_.upload(shares.offsets);
             share_sbp_.upload(shares.sbp);
@@ -158,7 +158,7 @@ class SolidBodies final : public Module {
             region_angular_acceleration_.assign(regions, Vec3{0, 0, 0});
             // The velocity–position correction's side of it (solid_contact.hpp): the SBPs' contact
             // masses, and the impulses they take, which wait for the next step's coupling.
-            if (setup.params.solid_correction) {
+            if (setup.params.coupling.correction) {
                 sbp_inverse_mass_.upload(sbp_inverse_contact_mass(L, shares));
                 sbp_impulse_.assign(sbp_count_, Vec3{0, 0, 0});
             }

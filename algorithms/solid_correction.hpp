@@ -17,13 +17,13 @@ class SolidCorrection final : public Module {
    public:
     // Whether a scene needs it.
     static bool needed(const SimulationState<Kernel>& state, const SolidBodies& solids) {
-        return state.has_fluid && solids.active() && state.params.solid_correction;
+        return state.has_fluid && solids.active() && state.params.coupling.correction;
     }
 
     SolidCorrection(SimulationState<Kernel>& state, Fluid<Kernel>& fluid, SolidBodies& solids,
                     const WallCorrection& walls)
         : state_(state), fluid_(fluid), solids_(solids), walls_(walls), active_(needed(state, solids)) {
-        if (!(state.params.solid_slip >= 0 && state.params.solid_slip <= 1))
+        if (!(state.params.coupling.slip >= 0 && state.params.coupling.slip <= 1))
             throw InputError("simulation setup: the solids' slip factor must be in [0, 1]");
         if (!active_) return;
         const std::size_t moving = state.store.moving_count();
@@ -53,7 +53,7 @@ class SolidCorrection final : public Module {
         ParticleStore& store = state_.store;
         const std::size_t fluid_count = step.ranges.fluid_end;
         const SolidContactData contact =
-            solids_.contact(step.solid_surface, state_.params.solid_slip, state_.fluid.mass, impulse_per_weight_.view().data());
+            solids_.contact(step.solid_surface, state_.params.coupling.slip, state_.fluid.mass, impulse_per_weight_.view().data());
         if (solids_.contact_takes_impulses()) {
             View<Vec3> corrected_position = fluid_.scratch_after_integration(0);
             View<Vec3> corrected_velocity = fluid_.scratch_after_integration(1);

@@ -61,6 +61,22 @@ inline Real contact_distance(Real gap, Real r0) {
     return r0 < short_of_rest ? r0 : short_of_rest;
 }
 
+// A static box as the scene builder places it: its faces, how far its first boundary layer lies
+// from where fluid blocks start (sampling/wall_gap.hpp), and the closest a fluid particle kept by
+// the carve starts to a face (sampling/fluid_clearance.hpp). The walls' correction turns it into a
+// ContactBox.
+struct StaticBoxFaces {
+    Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+    Real layer_gap = 0;
+    Real carve_distance = 0;
+};
+
+// The band of a static box: as a wall's, and no wider than the carve lets fluid start.
+inline ContactBox contact_box(const StaticBoxFaces& box, Real r0) {
+    const Real band = contact_distance(box.layer_gap, r0);
+    return ContactBox{box.lo, box.hi, band < box.carve_distance ? band : box.carve_distance};
+}
+
 // A static mesh object's signed distance (values in backend memory), and how far from its surface
 // fluid moving into it is stopped.
 struct ContactField {

@@ -6,6 +6,7 @@
 // signed distance grids.
 #pragma once
 #include <algorithm>
+#include <vector>
 
 #include "algorithms/module.hpp"
 #include "algorithms/wall_contact.hpp"
@@ -15,22 +16,24 @@ MW_BACKEND_BEGIN
 class WallCorrection final : public Module {
    public:
     WallCorrection(const SimulationParams& params, bool has_fluid) {
-        if (!params.wall_correction) return;
+        if (!params.boundary.correction) return;
         const Real r0 = params.fluid.spacing;
-        if (params.domain_walls) {
-            if (!(params.wall_gap >= 0))
-                throw InputError("simulation setup: the domain walls' correction needs the walls' gap (params.wall_gap)");
-            walls_ = WallContact::for_domain(params.domain_min, params.domain_max, params.wall_gap, r0);
+        if (params.boundary.walls) {
+            if (!(params.boundary.wall_gap >= 0))
+                throw InputError("simulation setup: the domain walls' correction needs the walls' gap (params.boundary.wall_gap)");
+            walls_ = WallContact::for_domain(params.domain_min, params.domain_max, params.boundary.wall_gap, r0);
         }
         // Boxes and objects keep fluid out; without fluid there is nothing to keep.
         if (!has_fluid) return;
-        if (!params.static_boxes.empty()) {
-            boxes_.upload(params.static_boxes);
+        if (!params.boundary.static_boxes.empty()) {
+            std::vector<ContactBox> boxes;
+            for (const StaticBoxFaces& b : params.boundary.static_boxes) boxes.push_back(contact_box(b, r0));
+            boxes_.upload(boxes);
             walls_.boxes = boxes_.cview();
         }
-        if (!params.static_objects.empty()) {
+        if (!params.boundary.static_objects.empty()) {
             std::size_t values = 0;
-            for (const ContactField& c : params.static_objects) {
+            for (const ContactField& c : params.boundary.static_objects) {
                 if (c.field.nx < 2 || c.field.ny < 2 || c.field.nz < 2 || !(c.field.inv_spacing > 0))
                     throw InputError("simulation setup: a static object's distance grid needs 2 nodes or more per "
                                      "axis and a positive spacing");
@@ -38,10 +41,14 @@ class WallCorrection final : public Module {
                                                                            std::size_t(c.field.ny) *
                                                                            std::size_t(c.field.nz));
             }
-            if (values > params.static_object_distances.size())
+            if (values > params.boundary.static_object_distances.size())
                 throw InputError("simulation setup: a static object's distance grid reaches past the values given");
-            objects_.upload(params.static_objects);
-            object_distances_.upload(params.static_object_distances);
+            // Fluid rests closer to an object's surface particles than to a wall's layer: the band
+            // is kStaticObjectContact r0 from its surface.
+            std::vector<ContactField> objects = params.boundary.static_objects;
+            for (ContactField& c : objects) c.contact = Real(kStaticObjectContact * double(r0));
+            objects_.upload(objects);
+            object_distances_.upload(params.boundary.static_object_distances);
             walls_.objects = objects_.cview();
             walls_.object_distances = object_distances_.cview();
         }

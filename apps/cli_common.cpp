@@ -152,9 +152,9 @@ std::string choose_backend(const std::string& requested) {
 
 std::unique_ptr<Simulation> probe_on_host(SimulationSetup setup, const std::string& backend) {
     const BackendInfo target = backend == "cuda" ? cuda_backend_info() : openmp_backend_info();
-    SimulationParams::Lists& lists = setup.params.neighbor_lists;
-    if (lists == SimulationParams::Lists::kAuto)
-        lists = target.prefers_neighbor_lists ? SimulationParams::Lists::kOn : SimulationParams::Lists::kOff;
+    NeighborParams::Lists& lists = setup.params.neighbors.lists;
+    if (lists == NeighborParams::Lists::kAuto)
+        lists = target.prefers_neighbor_lists ? NeighborParams::Lists::kOn : NeighborParams::Lists::kOff;
     return create_openmp_simulation(setup, 0);
 }
 
@@ -200,9 +200,9 @@ double host_bytes_needed(const Scene& scene, const std::string& backend, bool ho
     // h = 2 r0) grows with the neighbour count, (h / 2 r0)³: at 2.5 r0 the benchmark's lists case
     // holds 691 bytes per fluid particle against 443 at 2 r0 (bench/results/...-session14-kernels.md).
     const ParticleEstimate n = estimate_particles(scene);
-    const bool lists = scene.params.neighbor_lists == SimulationParams::Lists::kAuto
+    const bool lists = scene.params.neighbors.lists == NeighborParams::Lists::kAuto
                            ? backend == "openmp"
-                           : scene.params.neighbor_lists == SimulationParams::Lists::kOn;
+                           : scene.params.neighbors.lists == NeighborParams::Lists::kOn;
     const double width = double(scene.params.fluid.support_radius) / (2.0 * double(scene.params.fluid.spacing));
     const double list_bytes = 180.0 * width * width * width;
     const double fluid_bytes = !host_layout ? 100.0 : lists ? 240.0 + list_bytes : 240.0;

@@ -45,7 +45,7 @@ int command_info(int argc, char** argv) {
     const double bytes_per_particle = counts.total() ? double(bytes) / double(counts.total()) : 0.0;
     const SolverParams& solver = scene.params.solver;
     const bool cfl = solver.dt_mode == TimeStepMode::kCfl;
-    const Real wall_gap = scene.walls ? scene.wall_gap() : Real(0);
+    const Real wall_gap = scene.walls() ? scene.wall_gap() : Real(0);
     const std::string heat_warning =
         heat_substeps_warning(probe->heat_substeps_needed(double(solver.dt)), scene.params.heat.max_substeps);
     const long frames = scene.writes_frames() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
@@ -59,7 +59,7 @@ int command_info(int argc, char** argv) {
         p["total"] = counts.total();
         j["particles"] = p;
         j["fluid_carved"] = carved_fluid;
-        if (scene.walls) j["wall_gap_m"] = wall_gap;  // the first wall layer's distance outside the faces
+        if (scene.walls()) j["wall_gap_m"] = wall_gap;  // the first wall layer's distance outside the faces
         j["warnings"] = SceneJson::array();
         for (const std::string& warning : {scene.kernel_warning(), heat_warning, emitter_warning})
             if (!warning.empty()) j["warnings"].push_back(warning);
@@ -132,7 +132,7 @@ int command_info(int argc, char** argv) {
         std::printf("surface     the fluid's surface with every frame (frames/surface_NNNNN.obj): its colour field on "
                     "nodes %g r0 apart, meshed%s\n",
                     scene.surface_voxel, scene.writes_vtu() ? "" : " (no particle frames: output.formats has no \"vtu\")");
-    if (scene.walls)
+    if (scene.walls())
         std::printf("boundary    domain walls, %d layer(s) at %g m, the first %.3g r0 outside the faces (where fluid "
                     "next to a face starts at rest density for h %.3g r0); %zu static box(es)\n",
                     scene.boundary_layers, double(scene.boundary_spacing()), double(wall_gap / f.spacing),
@@ -141,17 +141,17 @@ int command_info(int argc, char** argv) {
         std::printf("boundary    no domain walls; %zu static box(es)\n", scene.static_boxes.size());
     const bool boxes = !scene.static_boxes.empty();
     // Static objects the correction covers: those with a distance grid (none without fluid).
-    const long static_objects = long(setup.params.static_objects.size());
-    if ((scene.walls || boxes || static_objects) && scene.params.wall_correction) {
+    const long static_objects = long(setup.params.boundary.static_objects.size());
+    if ((scene.walls() || boxes || static_objects) && scene.params.boundary.correction) {
         // What the correction covers, and where it stops the fluid (algorithms/wall_contact.hpp).
         std::string covered, coarse_grid_warning;
         auto add = [&](const std::string& part) { covered += (covered.empty() ? "" : ", ") + part; };
-        if (scene.walls) add("about r0 from the walls' layer");
+        if (scene.walls()) add("about r0 from the walls' layer");
         if (boxes) add("about r0 from a static box");
         if (static_objects) {
             std::size_t nodes = 0;
             double coarsest = 0;
-            for (const ContactField& c : setup.params.static_objects) {
+            for (const ContactField& c : setup.params.boundary.static_objects) {
                 nodes += std::size_t(c.field.nx) * std::size_t(c.field.ny) * std::size_t(c.field.nz);
                 coarsest = std::max(coarsest, 1 / double(c.field.inv_spacing));
             }
@@ -172,7 +172,7 @@ int command_info(int argc, char** argv) {
                     "boundary stops %s\n",
                     covered.c_str());
         if (!coarse_grid_warning.empty()) std::printf("warning     %s\n", coarse_grid_warning.c_str());
-    } else if (scene.walls || boxes ||
+    } else if (scene.walls() || boxes ||
                std::any_of(scene.objects.begin(), scene.objects.end(),
                            [](const SceneObject& o) { return o.kind == SolidKind::kStatic; })) {
         std::printf("            velocity-position correction off (boundary.correction false): only the Akinci "
@@ -182,7 +182,7 @@ int command_info(int argc, char** argv) {
     const long moving_objects = std::count_if(scene.objects.begin(), scene.objects.end(),
                                               [](const SceneObject& o) { return o.kind != SolidKind::kStatic; });
     if (moving_objects && scene.has_fluid()) {
-        if (scene.params.two_way_coupling)
+        if (scene.params.coupling.two_way)
             std::printf("coupling    two-way (coupling.two_way): the fluid's pressure%s acts back on %ld moving "
                         "object(s), through their LSM regions\n",
                         f.wall_viscosity > 0 ? " and friction" : "", moving_objects);
@@ -190,15 +190,15 @@ int command_info(int argc, char** argv) {
             std::printf("coupling    one-way (coupling.two_way false): %ld moving object(s) push the fluid and "
                         "feel none of it\n",
                         moving_objects);
-        if (scene.params.solid_correction)
+        if (scene.params.coupling.correction)
             std::printf("            velocity-position correction against them on (coupling.correction): fluid moving "
                         "into one stops %.2f r0 from its surface%s, slip %g\n",
                         kMovingSolidContact,
-                        scene.params.two_way_coupling ? " and trades momentum with it" : " and takes its velocity",
-                        double(scene.params.solid_slip));
+                        scene.params.coupling.two_way ? " and trades momentum with it" : " and takes its velocity",
+                        double(scene.params.coupling.slip));
         else
             std::printf("            velocity-position correction against them off (coupling.correction false)\n");
-        if (scene.params.solid_prediction)
+        if (scene.params.coupling.predict_solids)
             std::printf("            PCISPH meets them where they will be at the end of the step "
                         "(coupling.predict_solids): rigid ones at their particles' velocity, soft ones at "
                         "their mean velocity\n");

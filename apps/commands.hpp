@@ -7,4 +7,5 @@ int command_run(int argc, char** argv);
 int command_info(int argc, char** argv);
 int command_backends(int argc, char** argv);
 int command_sample(int argc, char** argv);
+int command_schema(int argc, char** argv);
 }  // namespace mw

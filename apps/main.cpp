@@ -17,7 +17,8 @@ void print_usage(std::FILE* to) {
         "  info [SCENE]     particle counts, memory estimate and the stages that will run\n"
         "  backends         the backends compiled in and the devices found\n"
         "  sample MESH      sample a mesh into surface, inner and geometry particles\n"
-        "Run 'meltwater <command> --help' for the options of a command.\n");
+        "  schema           every scene key with its default and meaning; --stages: the time step\n"
+        "Run 'meltwater <command> --help' for the options of a command; 'meltwater --version' for the version.\n");
 }
 }  // namespace
 
@@ -26,13 +27,18 @@ int main(int argc, char** argv) {
         print_usage(argc < 2 ? stderr : stdout);  // no command is an error: usage on stderr, exit 2
         return argc < 2 ? 2 : 0;
     }
+    if (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "-V")) {
+        std::printf("meltwater %s\n", MW_VERSION);
+        return 0;
+    }
     const std::string command = argv[1];
     try {
         if (command == "run") return mw::command_run(argc - 1, argv + 1);
         if (command == "info") return mw::command_info(argc - 1, argv + 1);
         if (command == "backends") return mw::command_backends(argc - 1, argv + 1);
         if (command == "sample") return mw::command_sample(argc - 1, argv + 1);
-        std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample)\n",
+        if (command == "schema") return mw::command_schema(argc - 1, argv + 1);
+        std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample, schema)\n",
                      mw::printable(command.c_str()).c_str());
         return 2;
     } catch (const mw::InputError& e) {

@@ -20,7 +20,7 @@ using SceneJson = nlohmann::ordered_json;  // keeps the keys in the order they w
 struct FluidBlock {
     Vec3 min{}, max{};
     Vec3 velocity{0, 0, 0};
-    Real temperature = 20;  // °C, with heat conduction (fluid.temperature by default)
+    Real temperature = 20;  // C, with heat conduction (fluid.temperature by default)
 };
 
 struct StaticBox {
@@ -28,64 +28,45 @@ struct StaticBox {
     int layers = 1;
 };
 
-// A solid object from a mesh (docs/scenes.md, "objects"; docs/lsm.md).
-struct SceneObject {
+// A solid object from a mesh (docs/scenes.md, "objects"; docs/lsm.md): its parameters (the solids
+// module's), the mesh and where it goes, and the apps' part (start, pins).
+struct SceneObject : SolidParams {
     std::string name;
     std::string mesh_file;        // an OBJ file (relative paths: from the scene file's folder) ...
     std::string mesh_procedural;  // ... or a procedural spec such as "box:x=0.5,y=0.1,z=0.1"
-    std::array<double, 3> scale{1, 1, 1}, rotation_deg{0, 0, 0}, translation{0, 0, 0};
-    SolidKind kind = SolidKind::kElastic;
-    Real density = 1000;
+    Vec3 scale{1, 1, 1}, rotation_deg{0, 0, 0}, translation{0, 0, 0};
     Vec3 velocity{0, 0, 0};
-    int region_half_width = 2;
-    Real stiffness = 1;
-    Real damping = 0;
-    Real wall_friction = 0.2;
-    Real interface_tension = 0;  // η, Eq. 9 (elastic and rigid objects)
-    Real temperature = 20;                    // °C, with heat conduction (fluid.temperature by default)
-    Real thermal_diffusivity = Real(1.43e-7); // m²/s (fluid.thermal_diffusivity by default)
-    Real heat_capacity = Real(4.18e6);        // ρc, J/(m³ K) (fluid.heat_capacity by default)
-    // Melting (docs/melting.md): elastic objects with heat.enabled; infinite: never melts.
-    Real melting_point = std::numeric_limits<Real>::infinity();  // °C
-    Real latent_heat = 0;                                        // J/kg
-    bool melts() const { return melting_point < std::numeric_limits<Real>::infinity(); }
+    Real temperature = 20;  // C, with heat conduction (fluid.temperature by default)
     enum class Pin { kNone, kBox, kHalfSpace } pin = Pin::kNone;
-    Vec3 pin_min{}, pin_max{};          // box
-    Vec3 pin_point{}, pin_normal{};     // half-space: IBPs with (x - point)·normal < 0 are pinned
+    Vec3 pin_min{}, pin_max{};       // box
+    Vec3 pin_point{}, pin_normal{};  // half-space: IBPs with (x - point).normal < 0 are pinned
 };
 
-// A fluid emitter (docs/scenes.md, "emitters"; algorithms/emitter.hpp): a disc releasing layers
-// of fluid at `speed` along `direction` from `start` to `end`.
-struct SceneEmitter {
+// A fluid emitter (docs/scenes.md, "emitters"; algorithms/emitter.hpp).
+struct SceneEmitter : EmitterParams {
     std::string name;
-    Vec3 center{0, 0, 0};
-    Vec3 direction{0, -1, 0};  // unit
-    Real radius = 0.05;
-    Real speed = 1;
-    double start = 0, end = 1;  // s
-    Real temperature = 20;      // °C, with heat conduction (fluid.temperature by default)
 };
 
 struct Scene {
     std::string name;
-    std::string source;                  // the file it came from, or "built-in default scene"
-    SimulationParams params;             // domain, gravity, fluid, solver, ordering
-    bool walls = true;                   // boundary.walls: line the domain with static boundary particles
-    Real boundary_spacing_factor = 0.5;  // boundary spacing = factor × r0
-    int boundary_layers = 1;
+    std::string description;
+    std::string source;       // the file it came from, or "built-in default scene"
+    SimulationParams params;  // every module's parameters
+    Real boundary_spacing_factor = 0.5;  // boundary.spacing_factor: boundary spacing = factor x r0
+    int boundary_layers = 1;             // boundary.layers
     // boundary.max_lost_fraction: the run stops (exit 4) once more than this share of the fluid has
-    // left the domain. With walls a loss means a leak or a blow-up, so the default is 1%; an open
-    // domain (walls false) lets fluid out by design, so there it defaults to 1 (never stop).
+    // left the domain. With walls a loss means a leak or a blow-up (default 1%); an open domain lets
+    // fluid out by design (default 1: never stop).
     double max_lost_fraction = 0.01;
     // solver.max_density_error: the run stops (exit 4) at the first step that ends with a peak
-    // density error above this. Since the walls' correction keeps the fluid inside them, a
-    // blow-up no longer shows as lost fluid; it shows as fluid packed far above its rest density.
+    // density error above this. With the walls' correction a blow-up shows as fluid packed far
+    // above its rest density rather than as lost fluid.
     double max_density_error = 1.0;
     // solver.max_speed, m/s: the run stops (exit 4) at the first step that ends with a fluid
     // particle or a solid's particle faster than this. None (null, the default): 20 times the
-    // scene's speed scale (speed_limit.hpp), so the limit follows the scene's size and gravity.
+    // scene's speed scale (speed_limit.hpp).
     std::optional<double> max_speed;
-    Real fluid_temperature = 20;  // fluid.temperature, °C: the fluid blocks' default
+    Real fluid_temperature = 20;  // fluid.temperature, C: the fluid blocks' and objects' default
     std::vector<FluidBlock> fluid_blocks;
     std::vector<StaticBox> static_boxes;
     std::vector<SceneObject> objects;
@@ -97,6 +78,7 @@ struct Scene {
     double surface_voxel = 0.5;  // output.surface.voxel: the surface field's node spacing, in r0
     SceneJson resolved;  // every key with its value, defaults filled in, overrides applied
 
+    bool walls() const { return params.boundary.walls; }
     Real boundary_spacing() const { return boundary_spacing_factor * params.fluid.spacing; }
     // Whether the scene has fluid from the start or from an emitter (melting objects aside).
     bool has_fluid() const { return !fluid_blocks.empty() || !emitters.empty(); }
@@ -112,6 +94,10 @@ struct Scene {
     // moving objects.
     double largest_heat_diffusivity() const;
 };
+
+// Every scene key, in the order the reader reads them, for the reference table of docs/scenes.md
+// (`meltwater schema`).
+std::vector<ParamDoc> scene_schema();
 
 // A warning when the largest step needs more heat sub-steps than heat.max_substeps allows ("" when
 // it does not; Simulation::heat_substeps_needed gives `needed`).

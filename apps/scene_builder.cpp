@@ -140,7 +140,7 @@ ParticleEstimate estimate_particles(const Scene& scene) {
     const double r0 = scene.params.fluid.spacing, rb = scene.boundary_spacing();
     ParticleEstimate n;
     for (const auto& b : scene.fluid_blocks) n.fluid += lattice_count(b.min, b.max, r0);
-    if (scene.walls)
+    if (scene.walls())
         n.boundary += surface_count(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers);
     for (const auto& b : scene.static_boxes) n.boundary += surface_count(b.min, b.max, rb, b.layers);
     for (const auto& e : scene.emitters) {
@@ -187,9 +187,9 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         block_end.push_back(setup.position.size());
     }
     const Real rb = scene.boundary_spacing();
-    setup.params.domain_walls = scene.walls;
-    setup.params.wall_gap = scene.walls ? scene.wall_gap() : Real(-1);
-    if (scene.walls)
+    setup.params.boundary.walls = scene.walls();
+    setup.params.boundary.wall_gap = scene.walls() ? scene.wall_gap() : Real(-1);
+    if (scene.walls())
         // The first layer where fluid blocks touching a wall start at rest density (wall_gap.hpp).
         append(setup,
                sample_container_walls(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers,
@@ -200,13 +200,12 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     std::vector<Eigen::AlignedBox3d> boxes;
     for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
         const StaticBox& b = scene.static_boxes[i];
-        // The band the walls' correction keeps moving fluid out of (algorithms/wall_contact.hpp):
-        // 0.1 r0 short of where fluid rests against this box's layers, and no wider than the
-        // carve below lets fluid start.
+        // Where fluid rests against the box's layers, and the closest the carve below lets it
+        // start: the walls' correction sets its band from them (algorithms/wall_contact.hpp).
         const Real gap =
             rest_density_wall_gap(r0, scene.params.fluid.support_radius, rb, b.layers, scene.params.fluid.kernel);
         const Real carved = carved_face_distance(Real(kFluidClearance) * r0, rb);
-        setup.params.static_boxes.push_back(ContactBox{b.min, b.max, std::min(contact_distance(gap, r0), carved)});
+        setup.params.boundary.static_boxes.push_back(StaticBoxFaces{b.min, b.max, gap, carved});
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
                static_cast<std::int32_t>(i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
@@ -261,7 +260,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             // correction is on and there is fluid to stop).
             const bool any_melts = std::any_of(scene.objects.begin(), scene.objects.end(),
                                                [](const SceneObject& other) { return other.melts(); });
-            if (o.kind == SolidKind::kStatic && scene.params.wall_correction && (scene.has_fluid() || any_melts))
+            if (o.kind == SolidKind::kStatic && scene.params.boundary.correction && (scene.has_fluid() || any_melts))
                 add_static_object_distance(setup, object.mesh, scene.params.fluid.spacing, sealed_faces(scene));
             for (std::size_t i = first; check_overlaps && i < first + inner; ++i) {
                 const Vec3 x = setup.position[i];
@@ -367,9 +366,9 @@ TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {
         mesh = load_obj(path.string());
     }
     MeshTransform t;
-    t.scale = Vec3d(o.scale[0], o.scale[1], o.scale[2]);
-    t.rotation_deg = Vec3d(o.rotation_deg[0], o.rotation_deg[1], o.rotation_deg[2]);
-    t.translation = Vec3d(o.translation[0], o.translation[1], o.translation[2]);
+    t.scale = Vec3d(o.scale.x, o.scale.y, o.scale.z);
+    t.rotation_deg = Vec3d(o.rotation_deg.x, o.rotation_deg.y, o.rotation_deg.z);
+    t.translation = Vec3d(o.translation.x, o.translation.y, o.translation.z);
     apply_transform(mesh, t);
     return mesh;
 }
@@ -445,7 +444,7 @@ bool add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh
     const double contact = kStaticObjectContact * r0;
     const SignedDistanceGrid sdf = signed_distance_grid(mesh, r0 / 2, contact, kMaxObjectDistanceNodes, sealed);
     if (sdf.exit_triangles == 0) return false;
-    std::vector<Real>& values = setup.params.static_object_distances;
+    std::vector<Real>& values = setup.params.boundary.static_object_distances;
     if (values.size() + sdf.distance.size() > std::size_t(UINT32_MAX))
         throw InputError("the static objects' distance grids hold more than 2^32 values; increase fluid.spacing");
     ContactField c;
@@ -457,14 +456,14 @@ bool add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh
     c.field.nz = sdf.grid.dims[2];
     c.field.first = static_cast<std::uint32_t>(values.size());
     for (double d : sdf.distance) values.push_back(Real(d));
-    setup.params.static_objects.push_back(c);
+    setup.params.boundary.static_objects.push_back(c);
     return true;
 }
 
 SealedFace sealed_faces(const Scene& scene) {
     // A thousandth of r0: a face meant to stand on the floor or a box lies there to rounding.
     const double tolerance = 1e-3 * double(scene.params.fluid.spacing);
-    const bool walls = scene.walls;
+    const bool walls = scene.walls();
     const Vec3d lo(scene.params.domain_min.x, scene.params.domain_min.y, scene.params.domain_min.z);
     const Vec3d hi(scene.params.domain_max.x, scene.params.domain_max.y, scene.params.domain_max.z);
     std::vector<Eigen::AlignedBox3d> boxes;

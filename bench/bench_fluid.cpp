@@ -144,15 +144,15 @@ SimulationSetup dam_break(long target, CellOrdering ordering, KernelKind kernel 
     s.params.fluid.kernel = kernel;
     s.params.solver.dt = Real(0.0015 * r0 / 0.02);
     s.params.solver.eta_max = Real(default_eta_max(s.params.solver.eta));  // the scenes' stopping rule
-    s.params.ordering = ordering;
+    s.params.neighbors.ordering = ordering;
     for (const Vec3& p : fill_box_lattice({0, 0, 0}, {0.6f, 0.8f, 0.8f}, r0)) {
         s.position.push_back(p);
         s.type.push_back(kFluid);
     }
-    s.params.domain_walls = true;
+    s.params.boundary.walls = true;
     const Real gap = rest_density_wall_gap(r0, s.params.fluid.support_radius, r0 / 2, 1, kernel);
-    s.params.wall_gap = gap;
-    s.params.wall_correction = true;  // as scenes/dam_break.json runs
+    s.params.boundary.wall_gap = gap;
+    s.params.boundary.correction = true;  // as scenes/dam_break.json runs
     for (const Vec3& p : sample_container_walls(s.params.domain_min, s.params.domain_max, r0 / 2, 1, gap)) {
         s.position.push_back(p);
         s.type.push_back(kStaticBoundary);
@@ -163,7 +163,7 @@ SimulationSetup dam_break(long target, CellOrdering ordering, KernelKind kernel 
 }
 
 SimulationSetup with_lists(SimulationSetup s, bool lists) {
-    s.params.neighbor_lists = lists ? SimulationParams::Lists::kOn : SimulationParams::Lists::kOff;
+    s.params.neighbors.lists = lists ? NeighborParams::Lists::kOn : NeighborParams::Lists::kOff;
     return s;
 }
 
@@ -411,7 +411,7 @@ int main(int argc, char** argv) {
             // fused into the prediction and the integration, so it should cost next to nothing).
             {
                 SimulationSetup uncorrected = with_lists(dam_break(100000, CellOrdering::kZOrder), true);
-                uncorrected.params.wall_correction = false;
+                uncorrected.params.boundary.correction = false;
                 variants.push_back(measure(o, "dam break 100k, Z-order cells, lists, walls' correction off", uncorrected,
                                            measured_steps(100000), 2, warmup_time(100000)));
             }
@@ -482,8 +482,8 @@ int main(int argc, char** argv) {
             std::vector<WholeRun> runs;
             for (const StepCase c : {StepCase{"0.4", "0.0015"}, StepCase{"1", "0.03"}}) {
                 const SimulationSetup with = build_setup(scene_at_step("dam_break_cylinder.json", c));
-                const ContactField field = with.params.static_objects.at(0);
-                const std::vector<Real>& distances = with.params.static_object_distances;
+                const ContactField field = with.params.boundary.static_objects.at(0);
+                const std::vector<Real>& distances = with.params.boundary.static_object_distances;
                 HostParticles particles;
                 const StepObserver count_inside = [&](Simulation& sim, WholeRun& r) {
                     sim.download(particles);
@@ -501,8 +501,8 @@ int main(int argc, char** argv) {
                     r.most_inside = std::max(r.most_inside, inside);
                 };
                 SimulationSetup without = with;
-                without.params.static_objects.clear();
-                without.params.static_object_distances.clear();
+                without.params.boundary.static_objects.clear();
+                without.params.boundary.static_object_distances.clear();
                 runs.push_back(run_whole(o, c.name() + ", object's correction on", with, end_time, count_inside));
                 runs.push_back(run_whole(o, c.name() + ", object's correction off", without, end_time, count_inside));
             }

@@ -215,7 +215,7 @@ void BackendSimulation<Kernel>::set_fluid_constants() {
     fluid.viscosity = fp.viscosity;
     fluid.wall_viscosity = fp.wall_viscosity;
     fluid.gravity = params_.gravity;
-    if (params_.domain_walls && fp.viscosity > 0)
+    if (params_.boundary.walls && fp.viscosity > 0)
         fluid.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::kAllFaces, fp.support_radius};
     // Mass such that the prototype lattice at spacing r0 has exactly the rest density.
     const PrototypeSums sums = prototype_sums(fluid.kernel, fp.spacing, 3);
@@ -238,7 +238,7 @@ void BackendSimulation<Kernel>::build_modules(const SimulationSetup& setup, cons
     NeighborSearch<Kernel>& search = add<NeighborSearch<Kernel>>(state_, lo, hi, arriving);
     SolidBodies& solids = add<SolidBodies>(device_);
     solids.init(setup, order, store);
-    solids.plan(store, params_.gravity, params_.domain_min, params_.domain_max, has_fluid && params_.solid_prediction);
+    solids.plan(store, params_.gravity, params_.domain_min, params_.domain_max, has_fluid && params_.coupling.predict_solids);
     search.on_sorted([&solids, &store] {
         if (solids.active()) solids.update_slot_map(store);  // slot -> store index after the sort
     });

@@ -31,7 +31,7 @@
 
 MW_BACKEND_BEGIN
 
-// Default for SimulationParams::neighbor_lists = kAuto: gathering from the sorted grid keeps memory per particle low; lists are to be measured on a GPU.
+// Default for neighbors.lists "auto" (NeighborParams::Lists::kAuto): gathering from the sorted grid keeps memory per particle low; lists are to be measured on a GPU.
 constexpr bool kPrefersNeighborLists = false;
 
 constexpr const char* kBackendName = "cuda";

@@ -27,7 +27,7 @@
 
 MW_BACKEND_BEGIN
 
-// Default for SimulationParams::neighbor_lists = kAuto: per-step neighbour lists beat re-gathering from the grid on CPU cores (measured).
+// Default for neighbors.lists "auto" (NeighborParams::Lists::kAuto): per-step neighbour lists beat re-gathering from the grid on CPU cores (measured).
 constexpr bool kPrefersNeighborLists = true;
 
 constexpr const char* kBackendName = "openmp";

@@ -85,7 +85,7 @@ TEST_CASE("defaults are filled in and recorded in the resolved scene") {
     CHECK(s.params.solver.eta_max == doctest::Approx(0.05));  // 5 eta
     CHECK(s.params.solver.min_iterations == 3);
     CHECK(s.params.solver.max_iterations == 100);
-    CHECK(s.params.ordering == CellOrdering::kZOrder);
+    CHECK(s.params.neighbors.ordering == CellOrdering::kZOrder);
     CHECK(s.boundary_spacing_factor == doctest::Approx(0.5));
     CHECK(s.boundary_layers == 1);
     CHECK(s.end_time == doctest::Approx(1.0));
@@ -123,7 +123,7 @@ TEST_CASE("--set overrides reach every kind of key") {
     CHECK(s.fluid_blocks[0].max.y == doctest::Approx(0.12));
     CHECK(s.formats.empty());
     CHECK(s.name == "renamed");
-    CHECK(s.params.ordering == CellOrdering::kLinear);
+    CHECK(s.params.neighbors.ordering == CellOrdering::kLinear);
     REQUIRE(s.static_boxes.size() == 1);
     CHECK(s.static_boxes[0].layers == 2);
     CHECK(s.resolved["solver"]["eta"].get<double>() == doctest::Approx(0.005));
@@ -295,12 +295,12 @@ TEST_CASE("a static object gets a signed distance grid for the correction only w
         R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "transform": {"translation": [0.15, 0.1, 0.1]},
                         "kind": "static"}])";
     const SimulationSetup on = build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=true"}));
-    REQUIRE(on.params.static_objects.size() == 1);
-    const ContactField& c = on.params.static_objects[0];
+    REQUIRE(on.params.boundary.static_objects.size() == 1);
+    const ContactField& c = on.params.boundary.static_objects[0];
     const Real r0 = 0.02f;
     CHECK(c.contact == doctest::Approx(kStaticObjectContact * r0));
     CHECK(c.field.first == 0);
-    CHECK(on.params.static_object_distances.size() == std::size_t(c.field.nx) * c.field.ny * c.field.nz);
+    CHECK(on.params.boundary.static_object_distances.size() == std::size_t(c.field.nx) * c.field.ny * c.field.nz);
     CHECK(1 / c.field.inv_spacing == doctest::Approx(r0 / 2));
     // The grid reaches past the band and one more cell beyond the sphere on every side.
     CHECK(c.field.origin.x <= 0.15f - 0.03f - c.contact - r0 / 2);
@@ -308,8 +308,8 @@ TEST_CASE("a static object gets a signed distance grid for the correction only w
     // Negative at the centre, about the radius deep.
     Real d = 0;
     Vec3 g{0, 0, 0};
-    REQUIRE(c.field.sample(View<const Real>{on.params.static_object_distances.data(),
-                                            on.params.static_object_distances.size()},
+    REQUIRE(c.field.sample(View<const Real>{on.params.boundary.static_object_distances.data(),
+                                            on.params.boundary.static_object_distances.size()},
                            Vec3{0.15f, 0.1f, 0.1f}, d, g));
     CHECK(std::abs(d + 0.03f) < 0.0015f);  // the icosphere's facets lie a little inside the sphere
     // Two objects: the second grid's values follow the first's.
@@ -319,23 +319,23 @@ TEST_CASE("a static object gets a signed distance grid for the correction only w
                        {"mesh": {"procedural": "box:x=0.04,y=0.04,z=0.04"}, "transform": {"translation": [0.15, 0.15, 0.15]},
                         "kind": "static"}])";
     const SimulationSetup both = build_setup(parse_scene_text(tiny_scene_text(two), "t", {"boundary.correction=true"}));
-    REQUIRE(both.params.static_objects.size() == 2);
-    const ContactField& second = both.params.static_objects[1];
+    REQUIRE(both.params.boundary.static_objects.size() == 2);
+    const ContactField& second = both.params.boundary.static_objects[1];
     CHECK(second.field.first == std::uint32_t(c.field.nx * c.field.ny * c.field.nz));
-    CHECK(both.params.static_object_distances.size() ==
+    CHECK(both.params.boundary.static_object_distances.size() ==
           second.field.first + std::size_t(second.field.nx) * second.field.ny * second.field.nz);
-    const View<const Real> values{both.params.static_object_distances.data(), both.params.static_object_distances.size()};
+    const View<const Real> values{both.params.boundary.static_object_distances.data(), both.params.boundary.static_object_distances.size()};
     REQUIRE(second.field.sample(values, Vec3{0.15f, 0.15f, 0.15f}, d, g));
     CHECK(std::abs(d + 0.02f) < 1e-4f);  // the box's centre, 0.02 m from each face
-    REQUIRE(both.params.static_objects[0].field.sample(values, Vec3{0.15f, 0.1f, 0.1f}, d, g));
+    REQUIRE(both.params.boundary.static_objects[0].field.sample(values, Vec3{0.15f, 0.1f, 0.1f}, d, g));
     CHECK(std::abs(d + 0.03f) < 0.0015f);
     // None without the correction, for a moving object, or with no fluid to correct.
     CHECK(build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=false"}))
-              .params.static_objects.empty());
+              .params.boundary.static_objects.empty());
     CHECK(build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=true", "objects.0.kind=\"rigid\""}))
-              .params.static_objects.empty());
+              .params.boundary.static_objects.empty());
     CHECK(build_setup(parse_scene_text(tiny_scene_text(object), "t", {"boundary.correction=true", "fluid_blocks=[]"}))
-              .params.static_objects.empty());
+              .params.boundary.static_objects.empty());
 }
 
 // h a rounding error above r0 passes the scene's range (r0, 4 r0] but leaves no wall placement

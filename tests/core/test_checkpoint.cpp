@@ -29,8 +29,8 @@ bool bitwise_equal(const HostParticles& a, const HostParticles& b) {
 // second half.
 SimulationSetup column_and_thrown_box() {
     SimulationSetup setup = test::box_thrown_onto_pool(SolidKind::kElastic, 500, 0.11);
-    setup.params.solid_correction = true;
-    setup.params.solid_prediction = true;
+    setup.params.coupling.correction = true;
+    setup.params.coupling.predict_solids = true;
     return setup;
 }
 }  // namespace

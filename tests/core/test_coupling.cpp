@@ -26,8 +26,8 @@ TEST_CASE("two-way coupling keeps the momentum of fluid thrown at a free cube, w
                                         test::gather_mode_name(lists);
             CAPTURE(variant);
             test::CubeThrow coupled(kind, 2.0f, 0.001f);
-            coupled.setup.params.two_way_coupling = true;
-            coupled.setup.params.neighbor_lists = lists;
+            coupled.setup.params.coupling.two_way = true;
+            coupled.setup.params.neighbors.lists = lists;
             const std::unique_ptr<Simulation> sim = create_openmp_simulation(coupled.setup, 2);
             HostParticles p;
             sim->download(p);
@@ -64,7 +64,7 @@ TEST_CASE("two-way coupling keeps the momentum of fluid thrown at a free cube, w
     }
     // The same throw, one-way: the cube pushes the fluid back but feels nothing.
     test::CubeThrow one_way(SolidKind::kRigid, 2.0f, 0.001f);
-    one_way.setup.params.neighbor_lists = SimulationParams::Lists::kOn;
+    one_way.setup.params.neighbors.lists = NeighborParams::Lists::kOn;
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(one_way.setup, 2);
     HostParticles p;
     sim->download(p);
@@ -98,8 +98,8 @@ Floating float_box(double density_ratio, Real r0, bool correction = false) {
     setup.params.solver.dt_mode = TimeStepMode::kCfl;
     setup.params.solver.eta_max = 0.05f;
     setup.params.fluid.viscosity = 0.05f;  // damps the sloshing, as in the hydrostatic tests
-    setup.params.two_way_coupling = true;
-    setup.params.solid_correction = correction;
+    setup.params.coupling.two_way = true;
+    setup.params.coupling.correction = correction;
     SolidSetup solid;
     solid.name = "box";
     solid.kind = SolidKind::kRigid;

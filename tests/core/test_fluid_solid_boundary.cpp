@@ -28,11 +28,11 @@ struct ColumnOnSlab {
     SimulationSetup setup;
     std::vector<std::uint32_t> slab_particles;  // SBPs and IBPs, scene order
 
-    explicit ColumnOnSlab(SimulationParams::Lists lists) {
+    explicit ColumnOnSlab(NeighborParams::Lists lists) {
         setup = test::fluid_in_box({0, 0, 0}, {width, 0.7f, width}, {0, slab_top, 0}, {width, slab_top + water, width},
                                    r0, 0.001f);
         setup.params.fluid.viscosity = 0.05f;  // damps the settling sloshing, as in test_hydrostatic
-        setup.params.neighbor_lists = lists;
+        setup.params.neighbors.lists = lists;
         SolidSetup solid;
         solid.name = "slab";
         solid.kind = SolidKind::kElastic;
@@ -55,7 +55,7 @@ struct ColumnOnSlab {
 
 TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydrostatic profile, no leak") {
     // Neighbour lists, what OpenMP runs by default (kAuto); grid gathers are held to this run below.
-    ColumnOnSlab scene(SimulationParams::Lists::kOn);
+    ColumnOnSlab scene(NeighborParams::Lists::kOn);
     const Real r0 = ColumnOnSlab::r0, width = ColumnOnSlab::width, slab_top = ColumnOnSlab::slab_top;
     REQUIRE(scene.slab_particles.size() > 500);
     // Exactly the lattice layer next to the slab goes: 10 x 10 particles.
@@ -122,7 +122,7 @@ TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydros
 TEST_CASE("a water column on a pinned elastic slab: grid gathers follow neighbour lists through the landing") {
     const Real r0 = ColumnOnSlab::r0, slab_top = ColumnOnSlab::slab_top;
     const int steps = 100;
-    const ColumnOnSlab with_lists(SimulationParams::Lists::kOn), with_grid(SimulationParams::Lists::kOff);
+    const ColumnOnSlab with_lists(NeighborParams::Lists::kOn), with_grid(NeighborParams::Lists::kOff);
     const HostParticles a = test::run_steps(*create_openmp_simulation(with_lists.setup, 1), steps);
     const HostParticles b = test::run_steps(*create_openmp_simulation(with_grid.setup, 1), steps);
     REQUIRE(a.position.size() == b.position.size());
@@ -144,12 +144,12 @@ namespace {
 // tank at r0 = 0.02 m. One-way (two_way_coupling is off in code): the cube falls through the water
 // unhindered and pushes it aside as a moving boundary: the fluid sees boundary volumes that change
 // every step, and the cube's GPs and SBPs follow its IBPs.
-SimulationSetup cube_into_pool(SimulationParams::Lists lists) {
+SimulationSetup cube_into_pool(NeighborParams::Lists lists) {
     const Real r0 = 0.02f;
     SimulationSetup setup =
         test::fluid_in_box({0, 0, 0}, {0.4f, 0.5f, 0.4f}, {0, 0, 0}, {0.4f, 0.2f, 0.4f}, r0, 0.002f);
     setup.params.fluid.viscosity = 0.01f;
-    setup.params.neighbor_lists = lists;
+    setup.params.neighbors.lists = lists;
     SolidSetup solid;
     solid.name = "cube";
     solid.kind = SolidKind::kElastic;
@@ -168,8 +168,8 @@ void cube_into_pool_on_both_backends(bool two_way_corrected) {
         const std::string variant = test::gather_mode_name(lists);
         CAPTURE(variant);
         SimulationSetup setup = cube_into_pool(lists);
-        setup.params.two_way_coupling = two_way_corrected;
-        setup.params.solid_correction = two_way_corrected;
+        setup.params.coupling.two_way = two_way_corrected;
+        setup.params.coupling.correction = two_way_corrected;
         const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 40);
         const HostParticles &a = runs.openmp, &b = runs.cuda;
         REQUIRE(a.position.size() == b.position.size());

@@ -36,7 +36,7 @@ SimulationSetup hanging_layer(Real eta, int numbered_after = 0) {
     SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.3f, 0.6f, 0.3f}, {0.06f, 0.38f, 0.06f},
                                                {0.24f, 0.40f, 0.24f}, r0, 0.002f);
     setup.params.gravity = Vec3{0, -9.81f, 0};
-    setup.params.two_way_coupling = true;
+    setup.params.coupling.two_way = true;
     SolidSetup plate;
     plate.name = "plate";
     plate.kind = SolidKind::kElastic;
@@ -124,7 +124,7 @@ TEST_CASE("interface tension reaches an object numbered after static boxes, as s
 
 TEST_CASE("interface tension keeps the momentum of fluid thrown at a free cube") {
     test::CubeThrow thrown(SolidKind::kElastic, 2.0f, 0.001f);
-    thrown.setup.params.two_way_coupling = true;
+    thrown.setup.params.coupling.two_way = true;
     thrown.setup.solids[0].interface_tension = 0.2f;
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(thrown.setup, 2);
     HostParticles p;

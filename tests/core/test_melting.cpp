@@ -231,7 +231,7 @@ SimulationSetup ice_in_warm_water() {
     SimulationSetup setup = test::fluid_in_box(lo, hi, lo, Vec3{0.3f, 0.14f, 0.3f}, kR0, Real(0.002));
     setup.params.heat.enabled = true;
     setup.params.heat.fluid_diffusivity = Real(5e-3);
-    setup.params.two_way_coupling = true;
+    setup.params.coupling.two_way = true;
     SolidSetup solid = melting_solid(0, 2000);
     solid.thermal_diffusivity = Real(5e-3);
     test::add_box_solid(setup, Vec3d(0.1, 0.1, 0.1), Vec3d(0.15, 0.17, 0.15), solid, Vec3{0, 0, 0});

@@ -41,12 +41,12 @@ struct BoxObject {
         TriangleMesh mesh = make_box(Vec3d(0.2, 0.1, 0.2));
         for (Vec3d& v : mesh.vertices) v += Vec3d(centre.x, centre.y, centre.z);
         add_static_object_distance(setup, mesh, r0);
-        contact.objects = host_view(setup.params.static_objects);
-        contact.object_distances = host_view(setup.params.static_object_distances);
+        contact.objects = host_view(setup.params.boundary.static_objects);
+        contact.object_distances = host_view(setup.params.boundary.static_object_distances);
         lo = centre - Vec3{0.1f, 0.05f, 0.1f};
         hi = centre + Vec3{0.1f, 0.05f, 0.1f};
     }
-    Real band() const { return setup.params.static_objects[0].contact; }
+    Real band() const { return setup.params.boundary.static_objects[0].contact; }
 };
 
 }  // namespace
@@ -130,8 +130,8 @@ TEST_CASE("object contact: a thin plate whose middle plane the grid cannot see a
     for (Vec3d& v : plate.vertices) v += Vec3d(0.5, 0.5, 0.5);
     REQUIRE(add_static_object_distance(setup, plate, 0.02));
     WallContact contact;
-    contact.objects = host_view(setup.params.static_objects);
-    contact.object_distances = host_view(setup.params.static_object_distances);
+    contact.objects = host_view(setup.params.boundary.static_objects);
+    contact.object_distances = host_view(setup.params.boundary.static_object_distances);
     Vec3 x{0.5f, 0.5f, 0.5f}, v{0, -5, 0};
     contact.correct(x, v);
     CHECK(x.y > 0.5f + 0.004f);  // above the plate's top face
@@ -231,7 +231,7 @@ TEST_CASE("object contact: fluid found inside an object standing on the floor le
 })";
     const Scene scene = parse_scene_text(text, "post.json");
     const SimulationSetup setup = build_setup(scene);
-    REQUIRE(setup.params.static_objects.size() == 1);
+    REQUIRE(setup.params.boundary.static_objects.size() == 1);
     const Real r0 = 0.02f;
     // The same cylinder's grid with every face a way out, as before faces were sealed.
     SimulationSetup unsealed;
@@ -240,14 +240,14 @@ TEST_CASE("object contact: fluid found inside an object standing on the floor le
         const bool sealed = s == &setup;
         CAPTURE(sealed);
         WallContact contact = WallContact::for_domain(setup.params.domain_min, setup.params.domain_max,
-                                                      setup.params.wall_gap, r0);
-        contact.objects = host_view(s->params.static_objects);
-        contact.object_distances = host_view(s->params.static_object_distances);
+                                                      setup.params.boundary.wall_gap, r0);
+        contact.objects = host_view(s->params.boundary.static_objects);
+        contact.object_distances = host_view(s->params.boundary.static_object_distances);
         Vec3 x{0.4f - Real(0.6) * r0, Real(0.3) * r0, 0.3f}, v{-3, 0, 0};
         contact.correct(x, v);
         Real d = 0;
         Vec3 g{0, 0, 0};
-        REQUIRE(s->params.static_objects[0].field.sample(host_view(s->params.static_object_distances), x, d, g));
+        REQUIRE(s->params.boundary.static_objects[0].field.sample(host_view(s->params.boundary.static_object_distances), x, d, g));
         MESSAGE(std::string(sealed ? "base sealed" : "base a way out") << ": ends " << d / r0 << " r0 from the surface, at y = "
                                                            << x.y / r0 << " r0, moving " << v.x << " m/s along x");
         if (sealed) {
@@ -288,12 +288,12 @@ SimulationSetup throw_setup(const std::string& object, Real speed) {
                  "transform": { "translation": [0.6, 0.3, 0.3] }, "kind": "static" } ]
 })";
     SimulationSetup setup = build_setup(parse_scene_text(text, "throw.json"));
-    REQUIRE(setup.params.static_objects.size() == 1);
+    REQUIRE(setup.params.boundary.static_objects.size() == 1);
     return setup;
 }
 void drop_object_correction(SimulationSetup& setup) {
-    setup.params.static_objects.clear();
-    setup.params.static_object_distances.clear();
+    setup.params.boundary.static_objects.clear();
+    setup.params.boundary.static_object_distances.clear();
 }
 
 Throw throw_at(const std::string& object, Real speed, bool object_correction) {
@@ -304,7 +304,7 @@ Throw throw_at(const std::string& object, Real speed, bool object_correction) {
     for (Vec3d& v : target.vertices) v += Vec3d(0.6, 0.3, 0.3);
     SimulationSetup probe;
     add_static_object_distance(probe, target, 0.02);
-    const ContactField field = probe.params.static_objects[0];
+    const ContactField field = probe.params.boundary.static_objects[0];
     if (!object_correction) drop_object_correction(setup);
     auto sim = create_openmp_simulation(setup, 0);
     Throw result;
@@ -318,7 +318,7 @@ Throw throw_at(const std::string& object, Real speed, bool object_correction) {
             if (particles.type[i] != kFluid) continue;
             Real d = 0;
             Vec3 g{0, 0, 0};
-            if (!field.field.sample(host_view(probe.params.static_object_distances), particles.position[i], d, g))
+            if (!field.field.sample(host_view(probe.params.boundary.static_object_distances), particles.position[i], d, g))
                 continue;
             inside += d < 0;
             result.closest = std::min(result.closest, double(d) / 0.02);
@@ -365,10 +365,10 @@ TEST_CASE("object contact: fluid settling round a static object never meets the 
                  "transform": { "translation": [0.2, 0.2, 0.2] }, "kind": "static" } ]
 })";
     const SimulationSetup with = build_setup(parse_scene_text(text, "pool.json"));
-    REQUIRE(with.params.static_objects.size() == 1);
+    REQUIRE(with.params.boundary.static_objects.size() == 1);
     SimulationSetup without = with;
-    without.params.static_objects.clear();
-    without.params.static_object_distances.clear();
+    without.params.boundary.static_objects.clear();
+    without.params.boundary.static_object_distances.clear();
     auto a = create_openmp_simulation(with, 0);
     auto b = create_openmp_simulation(without, 0);
     while (a->time() < 1.0) {
@@ -409,7 +409,7 @@ TEST_CASE("CUDA and OpenMP agree on fluid thrown at a static sphere with its cor
         const std::string variant = test::gather_mode_name(lists);
         CAPTURE(variant);
         SimulationSetup variant_setup = setup;
-        variant_setup.params.neighbor_lists = lists;
+        variant_setup.params.neighbors.lists = lists;
         // Through the step in which the correction first acts (above). On an H200 the backends
         // differ by 1.8e-5 m (grid gathers) and 4e-7 m (lists) after it, and by 1.3e-2 m and
         // 2e-5 m after 40 steps, as far as the nudge parts two OpenMP runs.

@@ -73,7 +73,7 @@ TEST_CASE("CUDA against CUDA: two runs are bitwise identical (grid gathers and n
     for (const auto lists : test::kGatherModes) {
         CAPTURE(test::gather_mode_name(lists));
         SimulationSetup setup = small_dam_break();
-        setup.params.neighbor_lists = lists;
+        setup.params.neighbors.lists = lists;
         const HostParticles first = test::run_steps(*create_cuda_simulation(setup), 50);
         const HostParticles second = test::run_steps(*create_cuda_simulation(setup), 50);
         CHECK(bitwise_equal(first, second));
@@ -84,14 +84,14 @@ TEST_CASE("CUDA against CUDA: two runs are bitwise identical (grid gathers and n
 }
 
 namespace {
-void compare_cuda_with_openmp(SimulationParams::Lists lists, KernelKind kernel = KernelKind::kCubicSpline,
+void compare_cuda_with_openmp(NeighborParams::Lists lists, KernelKind kernel = KernelKind::kCubicSpline,
                               Real support_in_r0 = 2) {
     if (!cuda_backend_info().available) {
         MW_SKIP(cuda_backend_info().description);
         return;
     }
     SimulationSetup setup = small_dam_break(kernel, support_in_r0);
-    setup.params.neighbor_lists = lists;  // the same neighbour structure on both sides
+    setup.params.neighbors.lists = lists;  // the same neighbour structure on both sides
     const test::OpenmpAndCuda runs = test::run_openmp_and_cuda(setup, 50);
     const HostParticles &cpu = runs.openmp, &gpu = runs.cuda;
     REQUIRE(cpu.position.size() == gpu.position.size());
@@ -107,16 +107,16 @@ void compare_cuda_with_openmp(SimulationParams::Lists lists, KernelKind kernel =
 }  // namespace
 
 TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break, grid gathers") {
-    compare_cuda_with_openmp(SimulationParams::Lists::kOff);
+    compare_cuda_with_openmp(NeighborParams::Lists::kOff);
 }
 
 TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break, neighbour lists") {
-    compare_cuda_with_openmp(SimulationParams::Lists::kOn);
+    compare_cuda_with_openmp(NeighborParams::Lists::kOn);
 }
 
 // The other kernel is another instantiation of the whole solver on each backend.
 TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break, Wendland C2 at h = 2.5 r0, grid gathers") {
-    compare_cuda_with_openmp(SimulationParams::Lists::kOff, KernelKind::kWendlandC2, 2.5);
+    compare_cuda_with_openmp(NeighborParams::Lists::kOff, KernelKind::kWendlandC2, 2.5);
 }
 
 // Lists hold the pairs within h at the start of a step; grid gathers also see pairs that come
@@ -124,9 +124,9 @@ TEST_CASE("CUDA and OpenMP agree on a 10k-particle dam break, Wendland C2 at h =
 // sized amounts that grow slowly, not bitwise.
 TEST_CASE("neighbour lists and grid gathers give the same dam break") {
     SimulationSetup setup = small_dam_break();
-    setup.params.neighbor_lists = SimulationParams::Lists::kOn;
+    setup.params.neighbors.lists = NeighborParams::Lists::kOn;
     const HostParticles with_lists = test::run_steps(*create_openmp_simulation(setup, 0), 50);
-    setup.params.neighbor_lists = SimulationParams::Lists::kOff;
+    setup.params.neighbors.lists = NeighborParams::Lists::kOff;
     const HostParticles with_grid = test::run_steps(*create_openmp_simulation(setup, 0), 50);
     const double worst = test::largest_position_difference(with_lists, with_grid);
     MESSAGE("largest position difference, lists against grid, after 50 steps: " << worst << " m");

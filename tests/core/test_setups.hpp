@@ -41,11 +41,11 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
         setup.position.push_back(p);
         setup.type.push_back(kFluid);
     }
-    setup.params.domain_walls = walls;
+    setup.params.boundary.walls = walls;
     if (walls) {
         const Real gap = rest_density_wall_gap(r0, setup.params.fluid.support_radius, r0 / 2, 1, kernel);
-        setup.params.wall_gap = gap;
-        setup.params.wall_correction = true;  // as the shipped scenes run (boundary.correction)
+        setup.params.boundary.wall_gap = gap;
+        setup.params.boundary.correction = true;  // as the shipped scenes run (boundary.correction)
         for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, gap)) {
             setup.position.push_back(p);
             setup.type.push_back(kStaticBoundary);
@@ -150,9 +150,9 @@ inline OpenmpAndCuda run_openmp_and_cuda(const SimulationSetup& setup, int steps
 
 // The two ways PCISPH can gather neighbours (per-step lists, or the grid in every iteration), and
 // their names for test messages: cross-backend tests run both.
-constexpr SimulationParams::Lists kGatherModes[] = {SimulationParams::Lists::kOff, SimulationParams::Lists::kOn};
-inline std::string gather_mode_name(SimulationParams::Lists lists) {
-    return lists == SimulationParams::Lists::kOn ? "neighbour lists" : "grid gathers";
+constexpr NeighborParams::Lists kGatherModes[] = {NeighborParams::Lists::kOff, NeighborParams::Lists::kOn};
+inline std::string gather_mode_name(NeighborParams::Lists lists) {
+    return lists == NeighborParams::Lists::kOn ? "neighbour lists" : "grid gathers";
 }
 
 // The largest distance |a.position[i] - b.position[i]| between two runs of the same setup, over the
@@ -339,7 +339,7 @@ inline SimulationSetup box_thrown_onto_pool(SolidKind kind, double density, doub
     setup.params.solver.dt_mode = TimeStepMode::kCfl;
     setup.params.solver.eta_max = 0.05f;
     setup.params.fluid.viscosity = 0.01f;
-    setup.params.two_way_coupling = true;
+    setup.params.coupling.two_way = true;
     SolidSetup solid;
     solid.name = "box";
     solid.kind = kind;

@@ -32,8 +32,8 @@ ThrowOutcome throw_at_cube(SolidKind kind, bool two_way, bool correction, Real s
     const Real r0 = test::CubeThrow::r0;
     test::CubeThrow thrown(kind, speed, dt);
     SimulationSetup& setup = thrown.setup;
-    setup.params.two_way_coupling = two_way;
-    setup.params.solid_correction = correction;
+    setup.params.coupling.two_way = two_way;
+    setup.params.coupling.correction = correction;
     const double fluid_mass = thrown.fluid_mass, ibp_mass = thrown.ibp_mass;
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 2);
 

@@ -26,8 +26,8 @@ struct Impact {
 Impact throw_box(SolidKind kind, double density, double drop, bool correction, bool prediction) {
     const Real r0 = 0.02f;
     SimulationSetup setup = test::box_thrown_onto_pool(kind, density, drop);
-    setup.params.solid_correction = correction;
-    setup.params.solid_prediction = prediction;
+    setup.params.coupling.correction = correction;
+    setup.params.coupling.predict_solids = prediction;
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
     Impact out;
     while (sim->time() < 0.2) {
@@ -83,9 +83,9 @@ TEST_CASE("a heavy box of eight vertices sinks into a shallow pool with its bott
     const Real r0 = 0.02f;
     SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.6f, 0.5f, 0.4f}, {0, 0, 0}, {0.6f, 0.2f, 0.4f}, r0, 0.002f);
     setup.params.fluid.viscosity = 0.01f;
-    setup.params.two_way_coupling = true;
-    setup.params.solid_correction = true;
-    setup.params.solid_prediction = true;
+    setup.params.coupling.two_way = true;
+    setup.params.coupling.correction = true;
+    setup.params.coupling.predict_solids = true;
     SolidSetup solid;
     solid.name = "box";
     solid.density = 917;

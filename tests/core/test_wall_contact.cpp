@@ -198,20 +198,21 @@ Impact drive_into_wall(bool correction, bool static_box = false) {
     SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.6f, 0.6f, 0.6f}, lo,
                                                lo + Vec3{0.12f, 0.12f, 0.12f}, r0, 0.002f);
     setup.params.gravity = {0, 0, 0};
-    setup.params.wall_correction = correction;
+    setup.params.boundary.correction = correction;
     if (static_box) {
-        const ContactBox box{{0.1f, 0.02f, 0.1f}, {0.2f, 0.3f, 0.5f}, r0};
+        // A band of r0 (contact_box: a layer gap of r0 leaves it at r0, as does a carve of r0).
+        const StaticBoxFaces box{{0.1f, 0.02f, 0.1f}, {0.2f, 0.3f, 0.5f}, r0, r0};
         for (const Vec3& p : sample_solid_box(box.lo, box.hi, r0 / 2, 1)) {
             setup.position.push_back(p);
             setup.velocity.push_back(Vec3{0, 0, 0});
             setup.type.push_back(kStaticBoundary);
             setup.object.push_back(0);
         }
-        setup.params.static_boxes.push_back(box);
+        setup.params.boundary.static_boxes.push_back(box);
     }
     // How far a particle is from the face the cube is driven at, the wall's (x = 0), or from the
     // box (0 inside it: the fluid also flows round the box, past its far side).
-    const ContactBox target = static_box ? setup.params.static_boxes[0] : ContactBox{};
+    const StaticBoxFaces target = static_box ? setup.params.boundary.static_boxes[0] : StaticBoxFaces{};
     auto clearance = [&](Vec3 x) {
         if (!static_box) return x.x;
         const Vec3 q{std::clamp(x.x, target.lo.x, target.hi.x), std::clamp(x.y, target.lo.y, target.hi.y),

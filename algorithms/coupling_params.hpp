@@ -1,0 +1,35 @@
+// How fluid and moving solids act on each other (two_way_coupling.hpp, solid_correction.hpp,
+// solid_bodies.hpp), scene section `coupling`. Host-only.
+#pragma once
+#include "simulation/parameters.hpp"
+
+namespace mw {
+
+struct CouplingParams {
+    // The forces the fluid feels from a moving solid's boundary particles act back on the solid.
+    bool two_way = false;
+    // The velocity-position correction against elastic and rigid objects' surface particles.
+    bool correction = false;
+    Real slip = 1;  // the correction's tangential rule: 1 free slip, 0 no slip
+    // PCISPH meets the moving solids' boundary particles where they will be at the end of the step.
+    bool predict_solids = false;
+};
+
+inline const ParamTable<CouplingParams>& coupling_keys() {
+    using T = CouplingParams;
+    static const ParamTable<T> table = [] {
+        ParamTable<T> t;
+        t.push_back(boolean_key<T>("coupling", "two_way", member(&T::two_way),
+                                   "the fluid's forces act back on elastic and rigid objects (docs/coupling.md)"));
+        t.push_back(boolean_key<T>("coupling", "correction", member(&T::correction),
+                                   "the velocity-position correction against elastic and rigid objects"));
+        t.push_back(number_key<T>("coupling", "slip", member(&T::slip), ParamRange{0, 1, false, false}, "",
+                                  "the correction's tangential rule: 1 free slip, 0 no slip"));
+        t.push_back(boolean_key<T>("coupling", "predict_solids", member(&T::predict_solids),
+                                   "PCISPH meets the objects where the step will take them, not where they start it"));
+        return t;
+    }();
+    return table;
+}
+
+}  // namespace mw
