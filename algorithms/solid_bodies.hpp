@@ -112,8 +112,8 @@ class SolidBodies final : public Module {
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
         // Each SBP's object, as an index into setup.solids (the layout's order: moving objects in
-        // turn, each one's SBPs together). Not setup.object, which numbers the static boxes first:
-        // with static boxes in a scene, an SBP's entry there is past the end of setup.solids.
+        // turn, each one's SBPs together), from the layout rather than from the number its
+        // particles carry (setup.object), which is only a label.
         sbp_object_.clear();
         for (std::size_t o = 0; o < setup.solids.size(); ++o)
             if (setup.solids[o].kind != SolidKind::kStatic)

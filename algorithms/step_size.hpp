@@ -1,6 +1,6 @@
 // The size of the next step in CFL mode (host only, one per simulation): the CFL bound, which
 // counts gravity's gain over the step, under a limit that PCISPH retries set and that grows back
-// adaptively (docs/solver.md, "Flat impacts" and "Eighth session: gravity in the CFL bound").
+// adaptively (docs/solver.md, "Time step").
 #pragma once
 #include <algorithm>
 #include <cmath>

@@ -12,16 +12,16 @@
 // The paper weights by m_s w_s; weighting by w_s alone keeps infinitely heavy SBPs (one-way
 // coupling, pinned lattice) finite, and the contact masses of one object's SBPs differ little.
 //
-// The paper builds k from P, the SBPs of S that the particle moves into ((v_i - v_s)·n_s < 0),
-// and so did this code until the twentieth session. Measured then: the SBPs along a box's edge
-// belong to one of its two faces, and a fluid particle resting beside the other face, moving
-// into a few of the first face's edge SBPs (up to r0 away, weights down to 1e-6) but not into
-// its own face's, got a k on the first face's plane, which, extended past the edge, put it up to
-// 1.1 r0 "inside": the correction pushed it 0.4-1.1 r0 along the wrong face, and the pool of
-// scenes/floating_boxes.json ran at up to 4.5 m/s with the correction against 1.0 m/s without
-// it. Built from S, k describes the surface as the density sees it, and the pool runs as calm
-// with the correction as without it. The cost, in fluid thrown at a cube at 4-6 times the CFL
-// step: more particles get in than with P (docs/coupling.md, "Measured").
+// The paper builds k from P, the SBPs of S that the particle moves into ((v_i - v_s)·n_s < 0).
+// Built from P, k goes wrong at a box's edge: the SBPs along an edge belong to one of its two
+// faces, and a fluid particle resting beside the other face, moving into a few of the first
+// face's edge SBPs (up to r0 away, weights down to 1e-6) but not into its own face's, gets a k
+// on the first face's plane, which, extended past the edge, puts it up to 1.1 r0 "inside": the
+// correction pushes it 0.4-1.1 r0 along the wrong face, and the pool of scenes/floating_boxes.json
+// runs at up to 4.5 m/s with the correction against 1.0 m/s without it. Built from S, k
+// describes the surface as the density sees it, and the pool runs as calm with the correction as
+// without it. The cost, in fluid thrown at a cube at 4-6 times the CFL step: more particles get
+// in than with P (docs/coupling.md).
 //
 // k's surface is a disc of radius kSurfacePatchRadius r0 round x_k in k's plane: a particle
 // beside the disc (past an edge of the object, where S holds only the SBPs nearest the edge) is

@@ -6,11 +6,10 @@
 //
 // Why: a single Akinci layer repels a fluid particle less and less as it comes close to the layer
 // (the layer's gradients cancel in its own plane), so a particle driven hard enough into a wall
-// passes through it. Measured (fifteenth session): in scenes/dam_break_paper_kernel.json the
-// returning wave presses a particle to 0.2 r0 from the back wall's layer at 3.7 m/s; its PCISPH
-// prediction lands behind the layer, where the wall pushes it outward, and the step ends with it
-// at 25 m/s through the wall (the 25 m/s "splash" and the one lost particle of the fourteenth
-// session's runs).
+// passes through it. Without the correction, in scenes/dam_break_paper_kernel.json the returning
+// wave presses a particle to 0.2 r0 from the back wall's layer at 3.7 m/s; its PCISPH prediction
+// lands behind the layer, where the wall pushes it outward, and the step ends with it at 25 m/s
+// through the wall (docs/solver.md).
 //
 // The rule: a fluid particle closer than `contact` to a boundary's first particle layer and
 // moving towards it is put back at `contact` from the layer and keeps no velocity into it (the
@@ -213,8 +212,8 @@ struct WallContact {
     }
     // Every fluid particle goes through this in the prediction and the integration: one
     // predictable test first (between the planes, nothing to do), then selects. Fully branched
-    // code kept those loops slow (fifteenth session, default dam break, 300 steps, 2 threads: the
-    // integration took 0.33 ms with branches, 0.17 ms with selects).
+    // code makes those loops slow (default dam break, 300 steps, 2 threads: the integration takes
+    // 0.33 ms with branches, 0.17 ms with selects).
     static MW_ALWAYS_INLINE void axis(Real& x, Real& v, Real lo_plane, Real hi_plane) {
         // -kFar <= x and v <= kFar keep an infinite position or velocity for the guard (NaN fails
         // every test by itself).

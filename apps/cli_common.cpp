@@ -193,7 +193,7 @@ double available_host_bytes() {
 
 double host_bytes_needed(const Scene& scene, const std::string& backend, bool host_layout) {
     // Peak host memory per particle, measured with /usr/bin/time on the 1M dam break (992k fluid,
-    // 568k wall particles, h = 2 r0; 2026-11-22, this project's 2-core VM): 459 MB building the
+    // 568k wall particles, h = 2 r0; the development VM): 459 MB building the
     // OpenMP layout (neighbour lists), 277 MB the CUDA layout (grid gathers), which these figures
     // reproduce within 2%. A GPU run keeps only the initial particles and frame buffers on the
     // host (about 100 bytes per particle). The lists' share (about 180 of the 420 bytes at

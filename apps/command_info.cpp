@@ -118,8 +118,9 @@ int command_info(int argc, char** argv) {
                     double(solver.cfl_number), double(solver.dt), stopping_rule, solver.min_iterations,
                     solver.max_iterations);
     else
-        std::printf("solver      fixed time step %g s (%ld steps to t=%g s), %s, %d..%d iterations\n",
-                    double(solver.dt), static_cast<long>(std::ceil(scene.end_time / solver.dt - 1e-9)), scene.end_time,
+        std::printf("solver      fixed time step %g s (%s to t=%g s), %s, %d..%d iterations\n", double(solver.dt),
+                    count_of(static_cast<long>(std::ceil(scene.end_time / solver.dt - 1e-9)), "step").c_str(),
+                    scene.end_time,
                     stopping_rule, solver.min_iterations, solver.max_iterations);
     std::printf("run         to t=%g s; %ld frames (%g per simulated second)\n", scene.end_time, frames, scene.fps);
     std::printf("guards      the run stops at a peak density error above %g (solver.max_density_error)",

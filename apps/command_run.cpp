@@ -420,8 +420,9 @@ int command_run(int argc, char** argv) {
         std::fprintf(stderr, "meltwater: error: could not record the failure: %s\n", e.what());
     }
     if (failure) {
-        std::fprintf(stderr, "meltwater: stopped after %ld steps at t=%.4g s; %d frames%s kept in %s\n", summary.steps,
-                     summary.simulated_time, summary.frames, recorded ? ", stats.csv and summary.json" : "",
+        std::fprintf(stderr, "meltwater: stopped after %s at t=%.4g s; %s%s kept in %s\n",
+                     count_of(summary.steps, "step").c_str(), summary.simulated_time,
+                     count_of(summary.frames, "frame").c_str(), recorded ? ", stats.csv and summary.json" : "",
                      out_dir.c_str());
         std::rethrow_exception(failure);
     }
@@ -429,8 +430,7 @@ int command_run(int argc, char** argv) {
     if (stats.retried_steps() > 0 && !quiet)
         std::fprintf(stderr,
                      "meltwater: note: %s taken again at a smaller dt because PCISPH diverged or ran out of "
-                     "iterations (column dt_retries of stats.csv; docs/solver.md, \"Flat impacts\" and "
-                     "\"Sixteenth session\")\n",
+                     "iterations (column dt_retries of stats.csv; docs/solver.md, \"Time step\")\n",
                      (count_of(stats.retried_steps(), "step") + (stats.retried_steps() == 1 ? " was" : " were")).c_str());
     if (stats.diverged_steps() > 0)
         std::fprintf(stderr,
@@ -456,8 +456,9 @@ int command_run(int argc, char** argv) {
     if (summary.particles.by_type[kFluid] > 0 || stats.has_column("melted") || stats.has_column("emitted"))
         std::snprintf(fluid_figures, sizeof fluid_figures, "density error avg %.3g%% max %.3g%%, %.1f iterations/step",
                       100 * stats.density_error_avg(), 100 * stats.density_error_max(), stats.iterations_avg());
-    std::printf("meltwater: %s %ld steps to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",
-                interrupted ? "interrupted after" : "ran", summary.steps, summary.simulated_time, summary.wall_seconds,
+    std::printf("meltwater: %s %s to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",
+                interrupted ? "interrupted after" : "ran", count_of(summary.steps, "step").c_str(),
+                summary.simulated_time, summary.wall_seconds,
                 stats.median_total_ms(), fluid_figures);
     const std::string surfaces =
         summary.surfaces > 0 ? " and " + count_of(summary.surfaces, "surface") + " (" +

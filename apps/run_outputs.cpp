@@ -180,6 +180,7 @@ void FrameWriter::write_surface(int index, const TriangleMesh& mesh) const {
 
 void FrameWriter::write_objects(int index, const HostParticles& p) const {
     for (const SolidSetup& o : objects_) {
+        if (o.triangles.empty()) continue;  // a static box: no mesh
         char name[64];
         std::snprintf(name, sizeof name, "_%05d.obj", index);
         const bool moving = o.kind != SolidKind::kStatic;

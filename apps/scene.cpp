@@ -560,6 +560,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
     // summary.json) names them absolutely, so that it reproduces the run wherever it is saved.
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
         std::string& file = scene.objects[k].mesh_file;
+        scene.objects[k].mesh_file_given = file;
         if (file.empty() || std::filesystem::path(file).is_absolute()) continue;
         std::error_code error;
         const std::filesystem::path absolute =

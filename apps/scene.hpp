@@ -33,6 +33,7 @@ struct StaticBox {
 struct SceneObject : SolidParams {
     std::string name;
     std::string mesh_file;        // an OBJ file (relative paths: from the scene file's folder) ...
+    std::string mesh_file_given;  // ... as the scene wrote it (mesh_file is made absolute)
     std::string mesh_procedural;  // ... or a procedural spec such as "box:x=0.5,y=0.1,z=0.1"
     Vec3 scale{1, 1, 1}, rotation_deg{0, 0, 0}, translation{0, 0, 0};
     Vec3 velocity{0, 0, 0};

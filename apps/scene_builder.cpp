@@ -206,8 +206,9 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             rest_density_wall_gap(r0, scene.params.fluid.support_radius, rb, b.layers, scene.params.fluid.kernel);
         const Real carved = carved_face_distance(Real(kFluidClearance) * r0, rb);
         setup.params.boundary.static_boxes.push_back(StaticBoxFaces{b.min, b.max, gap, carved});
+        // One id space: objects[k] is body k, static_boxes[i] body (objects) + i.
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
-               static_cast<std::int32_t>(i));
+               static_cast<std::int32_t>(scene.objects.size() + i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }
     started_at(scene.fluid_temperature);  // static boxes are adiabatic too
@@ -221,18 +222,8 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
         const SceneObject& o = scene.objects[k];
         SolidSetup solid;
+        static_cast<SolidParams&>(solid) = o;
         solid.name = o.name;
-        solid.kind = o.kind;
-        solid.density = o.density;
-        solid.region_half_width = o.region_half_width;
-        solid.stiffness = o.stiffness;
-        solid.damping = o.damping;
-        solid.wall_friction = o.wall_friction;
-        solid.interface_tension = o.interface_tension;
-        solid.thermal_diffusivity = o.thermal_diffusivity;
-        solid.heat_capacity = o.heat_capacity;
-        solid.melting_point = o.melting_point;
-        solid.latent_heat = o.latent_heat;
         std::function<bool(const Vec3&)> pinned;
         if (o.pin == SceneObject::Pin::kBox) {
             const Vec3 lo = o.pin_min, hi = o.pin_max;
@@ -243,7 +234,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             const Vec3 p = o.pin_point, n = o.pin_normal;
             pinned = [p, n](const Vec3& x) { return dot(x - p, n) < 0; };
         }
-        const std::int32_t id = static_cast<std::int32_t>(scene.static_boxes.size() + k);
+        const std::int32_t id = static_cast<std::int32_t>(k);
         try {
             PlacedObject object;
             object.mesh = object_mesh(scene, o);
@@ -275,6 +266,14 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                              " particles; increase fluid.spacing");
     }
     check_objects_apart(scene, placed, boxes);
+    // The static boxes are bodies after the objects: static, their particles numbered so, no mesh.
+    for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
+        SolidSetup box;
+        box.kind = SolidKind::kStatic;
+        box.name = "static_box" + std::to_string(i);
+        box.spacing = r0;
+        setup.solids.push_back(std::move(box));
+    }
     long carved = 0;
     if (setup.position.size() > first_solid) {
         const std::vector<std::uint8_t> removed = carve_fluid(setup, Real(kFluidClearance) * r0, boxes, first_solid);
@@ -363,6 +362,14 @@ TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {
     } else {
         std::filesystem::path path(o.mesh_file);
         if (path.is_relative() && !scene.base_dir.empty()) path = std::filesystem::path(scene.base_dir) / path;
+        std::error_code error;
+        if (!std::filesystem::exists(path, error))
+            throw InputError(path.string() + ": mesh file does not exist (mesh.file \"" + o.mesh_file_given +
+                             "\" is read relative to " +
+                             (scene.base_dir.empty() ? std::string("the working directory")
+                                                     : "the scene file's folder " + scene.base_dir) +
+                             "; the meshes shipped with Meltwater are in shared/assets/meshes, beside the checkout: "
+                             "../shared/assets/meshes from its root)");
         mesh = load_obj(path.string());
     }
     MeshTransform t;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A GPU session in stages (issue 5), for a GPU machine lent through the `run` tool: 16 cores, nvcc,
+# A GPU session in stages, for a GPU machine lent through the `run` tool: 16 cores, nvcc,
 # ncu and compute-sanitizer, but none of this project's Debian packages and no network, so NOTHING
 # is built there. Here, first: `bench/gpu_bundle.sh` builds build-gpu and packs it (executables,
 # shared libraries, meshes) into gpu-bundle/meltwater-gpu.tar.xz. Then one or two run calls, each
@@ -189,7 +189,7 @@ need_gpu() {
   return 1
 }
 # compute-sanitizer and ncu do not work under gVisor (kernel 4.4.0: the sanitizer refuses the
-# device, ncu cannot load its profiler library; the device tool's KINDS.md, 2026-11-04): a stage
+# device, ncu cannot load its profiler library; the device tool's KINDS.md): a stage
 # that needs them says so instead of failing ten times.
 need_profilers() {
   [[ "$(uname -r)" != 4.4.0* ]] && return 0
@@ -348,8 +348,7 @@ stage_ncu() {
   say "scene: $(grep -E '^(particles|memory)' "$work/info.txt" | tr -s ' ' | tr '\n' ';')"
   # Pass 1: every launch's duration (one metric, one replay each).
   # --clock-control none: ncu's default locks the GPU's clocks to base for its replays, and the
-  # device tool's METHOD.md asks that the card's clocks be left alone (session 27 ran once with
-  # the default before this was fixed).
+  # device tool's METHOD.md asks that the card's clocks be left alone.
   local -a clock=(--clock-control none)
   run_logged "$work/ncu-times.log" "$(budget 240)" ncu "${clock[@]}" --metrics gpu__time_duration.sum \
     --kernel-name-base mangled -f -o "$work/ncu-times" "${run[@]}"

@@ -4,10 +4,10 @@
 // fluid's force on an SBP reaches the IBPs through the same weights, transposed (coupling.hpp).
 // On a coarse mesh (a procedural box has 8 vertices and 12 triangles) the whole pressure on a
 // face therefore lands on the few IBPs linked to its corner GPs, and the face can only move as
-// its corners do. Measured (twenty-fourth session; scenes/melting_ice.json's pool with a 0.3 m
-// elastic box, not melting): a corner of the box's bottom shot up at 6 m/s in its eleventh step
-// (t = 0.044 s), lifting the whole face with it, and PCISPH diverged at step 73. With no edge
-// longer than r0 each SBP's force stays within about h of it (docs/sampling.md, "GPs").
+// its corners do. Unrefined, in scenes/melting_ice.json's pool with a 0.3 m elastic box (not
+// melting), a corner of the box's bottom shoots up at 6 m/s in its eleventh step (t = 0.044 s),
+// lifting the whole face with it, and PCISPH diverges at step 73. With no edge longer than r0
+// each SBP's force stays within about h of it (docs/sampling.md).
 //
 // How: edges longer than the limit are split at their midpoints, each triangle into 2, 3 or 4
 // according to how many of its edges split (the midpoint shared by both triangles of an edge, so

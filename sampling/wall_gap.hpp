@@ -12,10 +12,10 @@ namespace mw {
 //
 // Why it is computed and not a constant: a wall layer stands for the fluid missing beyond the
 // face, and how much of it one sheet of particles represents depends on h/r0, on the spacing and
-// on the number of layers. 0.6 r0 (the constant until the twelfth session) is right only for
-// h = 2 r0 and one layer: at the paper's h = 2.5 r0 it left the fluid next to a face 9% over
-// its rest density, 15% along an edge and 21% in a corner, and a resting column blew up in its
-// first step at any Δt (docs/solver.md).
+// on the number of layers. A constant 0.6 r0 is right only for h = 2 r0 and one layer: at the
+// paper's h = 2.5 r0 it leaves the fluid next to a face 9% over its rest density, 15% along an
+// edge and 21% in a corner, and a resting column blows up in its first step at any Δt
+// (docs/solver.md).
 //
 // Computed for a flat face: the first fluid layer's density, from the half-lattice of fluid and
 // the infinite wall sheets (their Akinci volumes 1 / Σ_k W over all the layers), falls

@@ -87,7 +87,9 @@ struct SimulationSetup {
     std::vector<Vec3> position;
     std::vector<Vec3> velocity;
     std::vector<std::uint8_t> type;
-    std::vector<std::int32_t> object;  // -1 for fluid and domain walls; static boxes, then objects
+    // Each particle's body: its index in `solids` (the scene's objects, then its static boxes); -1
+    // for fluid and the domain walls.
+    std::vector<std::int32_t> object;
     std::vector<SolidSetup> solids;
     std::vector<EmitterSetup> emitters;
     // Initial temperature of every particle, °C (any consistent unit), with params.heat only:

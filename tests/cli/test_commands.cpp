@@ -626,7 +626,7 @@ std::string column_blowing_up() {
 }  // namespace
 
 TEST_CASE("guards: a blow-up inside the walls stops on solver.max_density_error") {
-    // Measured (2026-12-01): the peak density error passes 100% (the default) in step 7 and
+    // Measured: the peak density error passes 100% (the default) in step 7 and
     // reaches 2,400% by step 25 if the run goes on; never above 5% at 2 ms.
     const std::string column = column_blowing_up();
     SUBCASE("the default limit stops it, naming the step, the error and the key") {
@@ -663,7 +663,7 @@ TEST_CASE("guards: a blow-up inside the walls stops on solver.max_density_error"
 }
 
 TEST_CASE("guards: a run whose fluid is thrown about stops on solver.max_speed") {
-    // The same column at 8 ms with the density guard lifted: measured (2026-12-04), its fastest
+    // The same column at 8 ms with the density guard lifted: measured, its fastest
     // particle reaches 26 m/s by step 10, 52 m/s in step 13, 83 m/s in step 19 (and 1e3 m/s and
     // more later, while the CFL step of such a run would shrink towards its floor and the run
     // would grind on). The scene's speed scale is a fall through its 0.7 m: sqrt(2 g 0.7) =
@@ -729,7 +729,7 @@ TEST_CASE("CFL mode: a step that runs out of iterations above the tolerance is t
     // The default dam break at r0 = 0.04 m (6,000 particles), CFL number 0.8 under 10 ms, with
     // PCISPH capped at 10 iterations (a scene that trades iterations for speed). Steps that need
     // more than 10 at their size are taken again at half of it, so every step meets the
-    // tolerance. Measured (2026-12-01, float, OpenMP): 48 steps to 0.3 s, 4 of them retried;
+    // tolerance. Measured (float, OpenMP): 48 steps to 0.3 s, 4 of them retried;
     // with the retry for divergence only, steps are integrated unconverged (checked: this test
     // then fails).
     const std::string dir = out_dir("cfl_out_of_iterations");

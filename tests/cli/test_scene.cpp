@@ -272,7 +272,7 @@ TEST_CASE("static boxes and objects carve the fluid: none is left inside them or
     CHECK(inside_box == 0);
     CHECK(nearest >= kFluidClearance * r0 * (1 - 1e-4));  // exactly r0 stays, up to rounding
     // The solids' particle lists still name their own particles after the fluid was compacted.
-    REQUIRE(setup.solids.size() == 1);  // objects only: static boxes are plain boundary particles
+    REQUIRE(setup.solids.size() == 2);  // the object, then the static box (a body with no particle lists)
     const SolidSetup& sphere = setup.solids[0];
     REQUIRE(!sphere.ibp.empty());
     for (std::uint32_t i : sphere.ibp) CHECK(setup.type[i] == kInnerBoundary);
@@ -357,6 +357,31 @@ TEST_CASE("a support radius within rounding of the spacing is refused, naming th
 TEST_CASE("a scene too large to build is refused before allocating") {
     const Scene s = parse_scene_text(tiny_scene_text(), "t", {"domain.max=[1000,1000,1000]", "fluid.spacing=0.001"});
     CHECK_THROWS_AS(build_setup(s), InputError);
+}
+
+// One id space: a particle's object number is its body's index in setup.solids, the objects first
+// and then the static boxes (static bodies with no mesh).
+TEST_CASE("objects and static boxes share one id space, the index of their body in the setup") {
+    const Scene s = parse_scene_text(
+        tiny_scene_text(R"("static_boxes": [ { "min": [0.15, 0, 0.15], "max": [0.2, 0.05, 0.2] } ],
+  "objects": [ { "name": "cube", "mesh": { "procedural": "box:x=0.04,y=0.04,z=0.04" },
+                 "transform": { "translation": [0.15, 0.15, 0.05] }, "kind": "rigid" } ])"),
+        "t");
+    const SimulationSetup setup = build_setup(s);
+    REQUIRE(setup.solids.size() == 2);
+    CHECK(setup.solids[0].name == "cube");
+    CHECK(setup.solids[1].kind == SolidKind::kStatic);
+    CHECK(setup.solids[1].name == "static_box0");
+    long cube = 0, box = 0, other = 0;
+    for (std::size_t i = 0; i < setup.type.size(); ++i) {
+        if (setup.object[i] < 0) continue;
+        if (setup.object[i] == 0 && setup.type[i] != kStaticBoundary) ++cube;
+        else if (setup.object[i] == 1 && setup.type[i] == kStaticBoundary) ++box;
+        else ++other;
+    }
+    CHECK(cube > 0);
+    CHECK(box > 0);
+    CHECK(other == 0);
 }
 
 TEST_CASE("the setup has fluid first, walls and static boxes with their object ids") {

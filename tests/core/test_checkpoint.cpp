@@ -148,7 +148,7 @@ TEST_CASE("CUDA: a state saved on CUDA continues on OpenMP, and the other way ro
     }
     // Saved after 20 steps, with the box in the water: the loading backend holds exactly the state
     // saved, and its next step is the saving backend's next step, to rounding. Not compared over
-    // many steps: the box's entry is chaotic (measured on an H200, 2026-12-04): from step 15 on,
+    // many steps: the box's entry is chaotic (measured on an H200): from step 15 on,
     // the lookahead and the corrections turn the backends' rounding into a 6e-5 m difference in
     // a single step, and the two backends' runs are 7.9e-3 m apart after 40 steps. One step from
     // OpenMP's state of step 20 differed by at most 1.1e-5 m (and by 1.3e-4 m from step 16's);

@@ -189,10 +189,9 @@ TEST_CASE("a rigid box floats with the velocity-position correction against it t
     // under its bottom), so the float and the pool should not change. Measured at 0.5 (without
     // the correction / with it): draft 0.0352 / 0.0355 m, mean force over the weight 1.003 /
     // 1.003, tilt 0.063 / 0.053 r0, top fluid speed over the last 0.5 s 0.16 / 0.20 m/s (with
-    // the twenty-first session's lookahead at the box, coupling.predict_solids: 0.995, 0.108 r0,
-    // 0.22 m/s with the correction; docs/coupling.md). Until
-    // the twentieth session the virtual particle was built from the SBPs the fluid moved into
-    // (the paper's set), which pushed fluid resting by the box's edges along the wrong face
+    // the lookahead at the box, coupling.predict_solids: 0.995, 0.108 r0, 0.22 m/s with the
+    // correction; docs/coupling.md). A virtual particle built from the SBPs the fluid moves into
+    // (the paper's set) pushes fluid resting by the box's edges along the wrong face
     // (virtual_boundary.hpp): force 0.964, tilt 0.39 r0, top speed 1.98 m/s.
     const Real r0 = 0.02f;
     const double ratio = 0.5, box_y = 0.12, expected = ratio * box_y;

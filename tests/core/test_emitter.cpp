@@ -143,7 +143,7 @@ TEST_CASE("CUDA: a stream fills a tank as on OpenMP") {
         return;
     }
     // 60 steps (t = 0.19 s): the stream is in flight and has not yet met the floor, which it
-    // does in step 64. Measured on an H200 (2026-12-04): the backends differ by
+    // does in step 64. Measured on an H200: the backends differ by
     // 6e-8 m up to step 60, then the splash parts them (2e-4 m at step 65, 0.39 m at step 150); a
     // 1e-7 m nudge of the disc's points on OpenMP alone parts two OpenMP runs as far (0.29 m at
     // step 150), so after the impact only rounding is compared, and it is chaotic.

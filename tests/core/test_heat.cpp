@@ -2,7 +2,7 @@
 // two half-spaces at T1 and T2 brought into contact at t = 0 follow
 //   T(x, t) = (T1 + T2)/2 + (T2 - T1)/2 erf((x - x0) / (2 sqrt(α t))).
 //
-// Measured with the probe below (2026-12-02, the project's 2-core Intel Xeon VM, OpenMP, float):
+// Measured with the probe below (the project's 2-core Intel Xeon VM, OpenMP, float):
 // a fluid bar 60 x 9 x 9 r0 (r0 = 0.02 m, h = 2 r0, α = 0.02 m²/s) to t = 0.32 s (sqrt(α t) = 4 r0),
 // the particles within r0 of its axis against the profile. "rate": the fitted α over the true α
 // (run_contact); "worst": the largest error over T2 - T1.

@@ -48,7 +48,7 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
     // still sloshed (kinetic energy 0.02 J, particles at up to 0.2 m/s) and the worst layer's
     // figure depended on the phase: 0.9-2.8% over eight small changes of the set-up (μ ± 0.2%,
     // grid gathers instead of lists, the walls' mirror images on or off). Now 0.47-1.10% over the
-    // same eight, in float and in double (measured 2026-11-22, this VM).
+    // same eight, in float and in double (measured this VM).
     const int steps = 900, averaged = 100;
     const CubicSpline3D kernel = CubicSpline3D::with_support(2 * r0);
     const double rest_density = setup.params.fluid.rest_density;
@@ -100,11 +100,11 @@ TEST_CASE("hydrostatic column settles to the analytic pressure profile") {
     CHECK(worst_particle < 0.05);
 }
 
-// The paper's kernel width, h = 2.5 r0 (its Table 1: r0 0.02 m, h 0.05 m). Until the twelfth
-// session the domain walls' first layer sat 0.6 r0 outside the faces whatever h was, which is
-// right for h = 2 r0 only: at 2.5 r0 the fluid next to a face started 9% over rest density, and
-// this column diverged in its first step and lost 1,507 of its 2,000 particles within 1 s, at
-// Δt = 1 ms as at 0.5 ms. The walls are now placed for the kernel (sampling/wall_gap.hpp).
+// The paper's kernel width, h = 2.5 r0 (its Table 1: r0 0.02 m, h 0.05 m). With the domain
+// walls' first layer at a fixed 0.6 r0 outside the faces, which is right for h = 2 r0 only, the
+// fluid next to a face starts 9% over rest density at 2.5 r0, and this column diverges in its
+// first step and loses 1,507 of its 2,000 particles within 1 s, at Δt = 1 ms as at 0.5 ms. The
+// walls are placed for the kernel (sampling/wall_gap.hpp).
 // (At Δt = 2 ms with the scenes' peak bound eta_max = 0.05, which this set-up does not use,
 // PCISPH's iteration still diverges at this width after 15-18 steps: the wider kernel lowers the
 // step PCISPH holds; docs/solver.md.)

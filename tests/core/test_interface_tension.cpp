@@ -111,9 +111,9 @@ TEST_CASE("interface tension holds a fluid layer under a plate, which falls free
 }
 
 TEST_CASE("interface tension reaches an object numbered after static boxes, as scenes number them") {
-    // Each SBP's η was read from setup.solids[its object number] until the twenty-first session:
-    // past the end of setup.solids in a scene with static boxes before the object.
-    // The number is only a label: the run is the same to the last bit.
+    // An SBP's η comes from its object's entry in setup.solids, not from the object number the
+    // particles carry, which counts the static boxes as well. The number is only a label: the
+    // run is the same to the last bit.
     const Hanging first = hang(0.2f, 0.2), numbered_later = hang(0.2f, 0.2, 2);
     MESSAGE("0.2 s: the layer moved " << first.drop << " m; pull over weight " << first.force_over_weight);
     CHECK(numbered_later.drop == first.drop);

@@ -52,7 +52,7 @@ CollapseRun collapse(KernelKind kernel) {
 }  // namespace
 
 TEST_CASE("at h = 2.5 r0 the cubic spline throws particles out of a collapsing column, and Wendland C2 holds it") {
-    // Measured (AMD EPYC VM, 2026-12-01): the cubic spline throws a particle at 23.6 m/s in step
+    // Measured (AMD EPYC VM): the cubic spline throws a particle at 23.6 m/s in step
     // 21 (t = 0.029 s), its steps halved 4 times on the way; Wendland C2 reaches t = 0.045 s in 30
     // steps of 1.5 ms, none halved, at most 1.23 m/s.
     const CollapseRun cubic = collapse(KernelKind::kCubicSpline);

@@ -385,7 +385,7 @@ TEST_CASE("object contact: fluid settling round a static object never meets the 
 
 // The case the CUDA comparison below runs: 20 m/s at 0.5 ms. The correction first acts in step
 // 28: runs with and without it are bitwise the same through step 27 and up to 5.1e-3 m apart
-// after step 28 (neighbour lists; 2.9e-2 m with grid gathers; measured 2026-12-04). From then on
+// after step 28 (neighbour lists; 2.9e-2 m with grid gathers). From then on
 // the splash is chaotic: a 1e-7 m nudge of the block on OpenMP alone grows to 1e-2 m (lists) and
 // 4e-2 m (grid gathers) by step 40, which is why the comparison stops at step 28.
 TEST_CASE("object contact: fluid thrown at a static sphere at 20 m/s meets the correction within 28 steps") {

@@ -41,10 +41,9 @@ ThrowOutcome throw_at_cube(SolidKind kind, bool two_way, bool correction, Real s
     HostParticles p;
     // Momentum along x and kinetic energy of the fluid and the IBPs; the fluid particles inside
     // the cube: within r0/2 of one of its IBPs (a lattice of spacing r0, r0/2 inside its faces),
-    // so at or behind its surface; fluid resting on it is 1.2 r0 or more from them. (Until the
-    // twentieth session: within 0.75 r0, which also counts fluid up to r0/4 outside a face: one
-    // particle sliding out over the bottom face at its front edge, at 16 m/s, counted with the
-    // correction as it is now; docs/coupling.md.)
+    // so at or behind its surface; fluid resting on it is 1.2 r0 or more from them. (Within
+    // 0.75 r0 would also count fluid up to r0/4 outside a face, such as a particle sliding out over
+    // the bottom face at its front edge.)
     auto measure = [&](double& momentum, double& cube_momentum, double& energy, long& inside) {
         momentum = cube_momentum = energy = 0;
         inside = 0;

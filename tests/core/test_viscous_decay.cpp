@@ -10,10 +10,10 @@
 // What the walls do. Eq. 4 sums over fluid neighbours, so a particle within h of a wall would
 // miss the neighbours beyond it and feel less viscous stress: up to half its Laplacian. Near the y
 // walls that matters where cos² is largest; near the side walls (z), where the mode does not vary,
-// the missing neighbours would have carried its y variation. Since the eleventh session the sum
-// also runs over the fluid's mirror images across the domain's free-slip walls
-// (algorithms/wall_mirror.hpp). Decay rate against ν (π/H)², measured with a probe of this set-up
-// (2026-11-22, this project's 2-core VM, OpenMP, float; H = 0.2 m, L = 1 m, μ = 4 Pa s; amplitude
+// the missing neighbours would have carried its y variation. The sum also runs over the fluid's
+// mirror images across the domain's free-slip walls (algorithms/wall_mirror.hpp). Decay rate
+// against ν (π/H)², measured with a probe of this set-up (the development VM, 2-core Intel Xeon,
+// OpenMP, float; H = 0.2 m, L = 1 m, μ = 4 Pa s; amplitude
 // over the middle fifth against the initial A, 0.5 s), by the depth D between the side walls:
 //
 //   r0 = 0.02 m                D = 4 r0   D = 10 r0   D = 20 r0   D = 20 r0 at r0 = 0.01 m (0.3 s)

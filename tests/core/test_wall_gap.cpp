@@ -69,8 +69,8 @@ StartDensities start_densities(Real r0, Real h, Real boundary_spacing, int layer
 
 TEST_CASE("the domain walls' gap starts fluid next to a face at rest density, for any kernel width and layering") {
     const Real r0 = Real(0.02);
-    // h = 2 r0 with one layer at r0/2 is the case the constant 0.6 r0 of earlier sessions was
-    // measured for: the computed gap must agree with it.
+    // h = 2 r0 with one layer at r0/2 is the case a constant gap of 0.6 r0 is right for: the
+    // computed gap must agree with it.
     CHECK(rest_density_wall_gap(r0, 2 * r0, r0 / 2, 1, kCubic) / r0 == doctest::Approx(0.6).epsilon(0.002));
 
     struct Case {
@@ -80,9 +80,9 @@ TEST_CASE("the domain walls' gap starts fluid next to a face at rest density, fo
         KernelKind kernel = KernelKind::kCubicSpline;
     };
     // The gap is set for a flat face; edges and corners see two and three faces' walls and start
-    // a little off. Measured 2026-11-22 (corners, in the order below): 1.0024, 1.0289, 1.0037,
+    // a little off. Measured (corners, in the order below): 1.0024, 1.0289, 1.0037,
     // 0.9814, 0.9993, 0.9758, 1.0504 (with the old 0.6 r0 at h = 2.5 r0: 1.215); with the Wendland
-    // C2 kernel (2026-12-01) 0.9981, 1.0229, 0.9950. The three-layer
+    // C2 kernel 0.9981, 1.0229, 0.9950. The three-layer
     // case tells each layer's Akinci volume apart (with the first layer's for all, the face starts
     // 0.7% under).
     for (const Case c : {Case{2.0, 0.5, 1, 1.01}, Case{2.5, 0.5, 1, 1.04}, Case{2.0, 0.25, 1, 1.01},

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Records tests/golden/NAME.csv: the physics columns of stats.csv (all but ms_*) of scenes/NAME.json
+# run for as many steps as the file holds rows (or STEPS), with the switches whose defaults
+# changed set as the recorded runs had them where the scene does not say (tests/cli/test_same_results.cpp).
+# Usage: tests/golden/record.sh BINARY NAME [STEPS]   (run from the repository root)
+set -euo pipefail
+bin=$1 name=$2
+golden="tests/golden/$name.csv"
+steps=${3:-$(($(wc -l <"$golden") - 1))}
+sets=$(python3 - "scenes/$name.json" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+for section, key in [("boundary", "correction"), ("coupling", "two_way"), ("coupling", "correction"),
+                     ("coupling", "predict_solids")]:
+    if key not in scene.get(section, {}):
+        print(f"--set {section}.{key}=false", end=" ")
+PY
+)
+out=$(mktemp -d)
+# shellcheck disable=SC2086
+"$bin" run "scenes/$name.json" --steps "$steps" --set 'output.formats=[]' --threads 2 --quiet --out "$out" $sets
+python3 - "$out/stats.csv" "$golden" <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+keep = [i for i, c in enumerate(rows[0]) if not c.startswith("ms_")]
+with open(sys.argv[2], "w") as f:
+    for r in rows:
+        f.write(",".join(r[i] for i in keep) + "\n")
+PY
+rm -rf "$out"
+echo "recorded $golden ($steps steps)"
