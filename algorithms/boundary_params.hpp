@@ -17,8 +17,8 @@ struct BoundaryParams {
     // negative: not given. The scene builder sets it from the walls it samples.
     Real wall_gap = -1;
     // The velocity-position correction against the domain walls, the static boxes and static mesh
-    // objects (wall_contact.hpp).
-    bool correction = false;
+    // objects (wall_contact.hpp): the paper's method, on unless a scene turns it off.
+    bool correction = true;
     // The static boxes (their particles are in the setup's lists) and the static mesh objects'
     // signed distance grids, each object's values one after another in static_object_distances
     // (ContactField::field.first), for that correction. Set by the scene builder.

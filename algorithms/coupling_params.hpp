@@ -5,14 +5,15 @@
 
 namespace mw {
 
+// The paper's method by default: each switch turns a part of it off.
 struct CouplingParams {
     // The forces the fluid feels from a moving solid's boundary particles act back on the solid.
-    bool two_way = false;
+    bool two_way = true;
     // The velocity-position correction against elastic and rigid objects' surface particles.
-    bool correction = false;
+    bool correction = true;
     Real slip = 1;  // the correction's tangential rule: 1 free slip, 0 no slip
     // PCISPH meets the moving solids' boundary particles where they will be at the end of the step.
-    bool predict_solids = false;
+    bool predict_solids = true;
 };
 
 inline const ParamTable<CouplingParams>& coupling_keys() {

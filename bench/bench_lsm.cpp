@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
             s.params.fluid.spacing = r0;
             s.params.fluid.support_radius = Real(0.05);
             s.params.solver.dt = Real(0.005);
+            s.params.boundary.walls = false;  // the cube alone: LSM keeps it inside the domain box
             TriangleMesh mesh = make_box(Vec3d(L, L, L));
             MeshTransform t;
             t.translation = Vec3d(0.1 + L / 2, 0.1 + L / 2, 0.1 + L / 2);

@@ -312,10 +312,10 @@ TEST_CASE("info: the velocity-position correction, on in the default scene, name
     const Result open = run("info --set boundary.walls=false");
     REQUIRE(open.code == 0);
     CHECK(!contains(open.out, "velocity-position correction"));  // nothing to correct against
-    // Off unless the scene asks for it.
+    // On unless the scene turns it off: the paper's method.
     const Result unasked = run("info " + tiny());
     REQUIRE(unasked.code == 0);
-    CHECK(contains(unasked.out, "velocity-position correction off"));
+    CHECK(contains(unasked.out, "velocity-position correction on (boundary.correction)"));
     check_rejected(run("info --set boundary.correction=1"), {"boundary.correction"});
 }
 
@@ -601,13 +601,12 @@ TEST_CASE("guards: a blow-up stops the run naming the step, keeping frame 0 and 
 
 TEST_CASE("guards: a speed whose square overflows stops the run as a failure") {
     // Finite velocity components, |v|² past the scalar type's range: before the guard looked at
-    // |v|², the energy went to inf, the particles left the grid and the run 'completed'. (The
-    // walls' correction would take the speed away at the wall in the first step: it stays off,
-    // as in every scene that does not ask for it.)
+    // |v|², the energy would go to inf and the particles leave the grid. (The walls' correction
+    // would take the speed away at the wall in the first step: it is turned off here.)
     const std::string speed = sizeof(mw::Real) == 4 ? "1e20" : "1e160";
     const std::string dir = out_dir("overflow");
     const Result r = run("run " + tiny() + " --steps 3 --quiet --out " + dir + " --set 'fluid_blocks.0.velocity=[" +
-                         speed + ",0,0]'");
+                         speed + ",0,0]' --set boundary.correction=false");
     CAPTURE(r.err);
     CHECK(r.code == 4);
     CHECK(contains(r.err, "speed overflowed"));
@@ -825,9 +824,9 @@ TEST_CASE("guards: a run that loses more fluid through its walls than boundary.m
     // gathers (CUDA's default) the first step's PCISPH diverges to 149% over rest density, so the
     // run stops on solver.max_density_error before any fluid leaves (measured on OpenMP and on an
     // H200 alike).
-    const std::string through_floor =
+    const std::string into_floor =
         " --set 'fluid_blocks.0.velocity=[0,-20,0]' --set 'output.formats=[]' --set neighbors.lists=on";
-    const std::string into_floor = through_floor + " --set boundary.correction=true";
+    const std::string through_floor = into_floor + " --set boundary.correction=false";
     SUBCASE("with the walls' correction nothing leaves, and the blow-up stops the run") {
         // Measured: the block's peak density error is 158% in the first step, and its top speed
         // reaches 96 m/s by step 5 if the run goes on: two spacings a step is far past what
@@ -872,9 +871,9 @@ TEST_CASE("guards: a run that loses more fluid through its walls than boundary.m
 }
 
 
-TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, when the scene asks for it") {
+TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, unless the scene turns it off") {
     const std::string scene = tiny_scene_with_box("coupled.json");
-    const nlohmann::json on = info_json(scene, "--set coupling.two_way=true");
+    const nlohmann::json on = info_json(scene);
     const std::vector<std::string> with = stages_of(on);
     // In the method's order: after PCISPH, before the solids' step.
     const auto pcisph = std::find(with.begin(), with.end(), "pcisph"), coupling = std::find(with.begin(), with.end(), "coupling"),
@@ -883,11 +882,11 @@ TEST_CASE("info: two-way coupling is a stage where fluid meets a moving object, 
     CHECK(pcisph < coupling);
     CHECK(coupling < lsm);
     CHECK(on["scene"]["coupling"]["two_way"] == true);
-    CHECK(contains(run("info " + scene + " --set coupling.two_way=true").out, "two-way (coupling.two_way)"));
-    CHECK(contains(run("info " + scene).out, "one-way (coupling.two_way false)"));
+    CHECK(contains(run("info " + scene).out, "two-way (coupling.two_way)"));
+    CHECK(contains(run("info " + scene + " --set coupling.two_way=false").out, "one-way (coupling.two_way false)"));
 
-    // Off by default, like every physics switch added after the first release.
-    const nlohmann::json off = info_json(scene);
+    // On by default (the paper's method); a scene may turn it off.
+    const nlohmann::json off = info_json(scene, "--set coupling.two_way=false");
     CHECK(off["scene"]["coupling"]["two_way"] == false);
     CHECK(!runs_stage(off, "coupling"));
     CHECK(off["device_bytes"].get<long>() < on["device_bytes"].get<long>());
@@ -918,15 +917,18 @@ TEST_CASE("info: the velocity-position correction against moving objects is a st
     CHECK(contains(run("info " + scene + " --set coupling.two_way=true --set coupling.correction=true").out,
                    "trades momentum with it"));
     // One-way too: the objects are then infinitely heavy, and the fluid takes their velocity.
-    const Result one_way = run("info " + scene + " --set coupling.correction=true");
+    const Result one_way = run("info " + scene + " --set coupling.two_way=false");
     REQUIRE(one_way.code == 0);
     CHECK(contains(one_way.out, "takes its velocity"));
 
-    // Off by default, like every physics switch added after the first release.
-    const nlohmann::json off = info_json(scene, "--set coupling.two_way=true");
+    // On by default (the paper's method); a scene may turn it off.
+    CHECK(info_json(scene)["scene"]["coupling"]["correction"] == true);
+    CHECK(runs_stage(info_json(scene), "solid_contact"));
+    const nlohmann::json off = info_json(scene, "--set coupling.correction=false");
     CHECK(off["scene"]["coupling"]["correction"] == false);
     CHECK(!runs_stage(off, "solid_contact"));
-    CHECK(contains(run("info " + scene).out, "correction against them off (coupling.correction false)"));
+    CHECK(contains(run("info " + scene + " --set coupling.correction=false").out,
+                   "correction against them off (coupling.correction false)"));
 
     const Result slip = run("info " + scene + " --set coupling.correction=true --set coupling.slip=1.5");
     CHECK(slip.code != 0);
@@ -936,13 +938,13 @@ TEST_CASE("info: the velocity-position correction against moving objects is a st
     CHECK(contains(wrong_type.err, "coupling.correction"));
 }
 
-TEST_CASE("info: PCISPH meets moving objects where they will be when coupling.predict_solids asks") {
+TEST_CASE("info: PCISPH meets moving objects where they will be, unless coupling.predict_solids is off") {
     const std::string scene = tiny_scene_with_box("lookahead.json");
-    // Off by default, like every physics switch added after the first release, and info says
-    // what that risks.
-    CHECK(info_json(scene)["scene"]["coupling"]["predict_solids"] == false);
-    CHECK(contains(run("info " + scene).out, "where they start the step (coupling.predict_solids false)"));
-    const Result on = run("info " + scene + " --set coupling.predict_solids=true");
+    // On by default (the paper's method); off, info says what that risks.
+    CHECK(info_json(scene)["scene"]["coupling"]["predict_solids"] == true);
+    CHECK(contains(run("info " + scene + " --set coupling.predict_solids=false").out,
+                   "where they start the step (coupling.predict_solids false)"));
+    const Result on = run("info " + scene);
     REQUIRE(on.code == 0);
     CHECK(contains(on.out, "where they will be at the end of the step"));
     const Result wrong_type = run("info " + scene + " --set coupling.predict_solids=1");

@@ -1,7 +1,7 @@
 // The shipped scenes take the same steps as the code they were recorded with. tests/golden/NAME.csv
 // holds the physics columns of stats.csv (every column but the stage times) of scenes/NAME.json
-// run for the file's row count, recorded when the coupling and the corrections were off unless a
-// scene asked for them; the run here sets those switches as they were, explicitly, and must give
+// run for the file's row count, with the switches of tests/golden/NAME.set (the coupling and the
+// corrections as the recorded run had them); the run here sets the same, explicitly, and must give
 // every recorded column, digit for digit. A change that moves a result on purpose records the
 // scene again (tests/golden/README.md says how).
 #include <doctest/doctest.h>
@@ -33,17 +33,12 @@ std::vector<std::vector<std::string>> read_csv(const std::string& path) {
     return rows;
 }
 
-// The switches whose defaults changed, as the recorded runs had them where a scene does not say.
-std::string recorded_switches(const std::string& scene_path) {
-    const nlohmann::json scene = nlohmann::json::parse(slurp(scene_path));
-    std::string options;
-    const std::pair<const char*, const char*> switches[] = {{"boundary", "correction"},
-                                                            {"coupling", "two_way"},
-                                                            {"coupling", "correction"},
-                                                            {"coupling", "predict_solids"}};
-    for (const auto& [section, key] : switches)
-        if (!scene.contains(section) || !scene[section].contains(key))
-            options += std::string(" --set ") + section + "." + key + "=false";
+// The recorded run's switches (NAME.set: one key=value a line), as --set options.
+std::string recorded_switches(const std::string& name) {
+    std::ifstream in(std::string(MW_SOURCE_DIR) + "/tests/golden/" + name + ".set");
+    std::string options, line;
+    while (std::getline(in, line))
+        if (!line.empty()) options += " --set " + line;
     return options;
 }
 
@@ -58,7 +53,7 @@ void check_scene(const std::string& name) {
     }
     const std::string out = out_dir("same_" + name);
     const Result r = run("run " + scene + " --steps " + std::to_string(golden.size() - 1) +
-                         " --set 'output.formats=[]' --threads 2 --quiet --out " + out + recorded_switches(scene));
+                         " --set 'output.formats=[]' --threads 2 --quiet --out " + out + recorded_switches(name));
     CAPTURE(r.err);
     REQUIRE(r.code == 0);
     const std::vector<std::vector<std::string>> now = read_csv(out + "/stats.csv");

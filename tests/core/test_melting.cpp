@@ -36,6 +36,7 @@ long count_type(const HostParticles& p, std::uint8_t type) {
 // A lattice cube of n³ vertices as an elastic object's IBPs (no mesh), for the region tests.
 SimulationSetup lattice_cube(int n, const std::vector<std::uint8_t>& keep = {}) {
     SimulationSetup setup;
+    setup.params.boundary.walls = false;
     SolidSetup solid;
     solid.name = "cube";
     solid.spacing = kR0;

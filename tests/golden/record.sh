@@ -1,21 +1,24 @@
 #!/usr/bin/env bash
 # Records tests/golden/NAME.csv: the physics columns of stats.csv (all but ms_*) of scenes/NAME.json
-# run for as many steps as the file holds rows (or STEPS), with the switches whose defaults
-# changed set as the recorded runs had them where the scene does not say (tests/cli/test_same_results.cpp).
+# run for as many steps as the file holds rows (or STEPS), with the switches of NAME.set
+# (tests/cli/test_same_results.cpp).
 # Usage: tests/golden/record.sh BINARY NAME [STEPS]   (run from the repository root)
 set -euo pipefail
 bin=$1 name=$2
 golden="tests/golden/$name.csv"
 steps=${3:-$(($(wc -l <"$golden") - 1))}
-sets=$(python3 - "scenes/$name.json" <<'PY'
+# The switches of NAME.set, or, for a new scene, those the scene gives (the defaults otherwise).
+if [[ ! -f "tests/golden/$name.set" ]]; then
+  python3 - "scenes/$name.json" >"tests/golden/$name.set" <<'PY'
 import json, sys
 scene = json.load(open(sys.argv[1]))
 for section, key in [("boundary", "correction"), ("coupling", "two_way"), ("coupling", "correction"),
                      ("coupling", "predict_solids")]:
-    if key not in scene.get(section, {}):
-        print(f"--set {section}.{key}=false", end=" ")
+    value = scene.get(section, {}).get(key, True)
+    print(f"{section}.{key}={'true' if value else 'false'}")
 PY
-)
+fi
+sets=$(sed 's/^/--set /' "tests/golden/$name.set" | tr '\n' ' ')
 out=$(mktemp -d)
 # shellcheck disable=SC2086
 "$bin" run "scenes/$name.json" --steps "$steps" --set 'output.formats=[]' --threads 2 --quiet --out "$out" $sets

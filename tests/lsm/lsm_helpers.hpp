@@ -24,6 +24,7 @@ inline SimulationSetup empty_setup(Vec3 lo, Vec3 hi, Real dt, Vec3 gravity, Real
     s.params.fluid.spacing = r0;
     s.params.fluid.support_radius = 2 * r0;
     s.params.solver.dt = dt;
+    s.params.boundary.walls = false;  // solids alone: LSM keeps them inside the domain box
     return s;
 }
 
