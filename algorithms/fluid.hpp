@@ -14,12 +14,10 @@ MW_BACKEND_BEGIN
 template <class Kernel>
 class Fluid final : public Module {
    public:
-    // `tension`: interface tension adds to the non-pressure forces (interface_tension.hpp);
-    // `corrected_later`: a later stage (solid_contact) moves the fluid after the integration and
-    // summarises its motion itself.
+    // `tension`: interface tension adds to the non-pressure forces (interface_tension.hpp).
     Fluid(SimulationState<Kernel>& state, const BoundaryVolumes<Kernel>& volumes, const WallCorrection& walls,
-          StepSizeControl& step_size, bool tension, bool corrected_later)
-        : state_(state), volumes_(volumes), walls_(walls), step_size_(step_size), summarizes_(!corrected_later) {
+          StepSizeControl& step_size, bool tension)
+        : state_(state), volumes_(volumes), walls_(walls), step_size_(step_size) {
         if (!state.has_fluid) return;
         const FluidParams& fp = state.params.fluid;
         const std::size_t moving = state.store.moving_count();
@@ -37,13 +35,10 @@ class Fluid final : public Module {
         plan.bind("integrate", [this](StepContext& step) { integrate(step); });
     }
 
-    // The reductions a step reads back make their workspaces on first use: one call of each here.
+    // The density error's reduction makes its workspace on first use: once here, before the first step.
     void start(const StepContext& first) override {
         if (!state_.has_fluid) return;
-        const ParticleStore& store = state_.store;
-        density_error(state_.device, first.ranges.fluid_end, store.density.cview(), state_.fluid.rest_density);
-        summarize_motion(state_.device, first.ranges.fluid_end, store.position.cview(), store.velocity.cview(),
-                         state_.fluid.mass);
+        density_error(state_.device, first.ranges.fluid_end, state_.store.density.cview(), state_.fluid.rest_density);
     }
 
     // Gravity, viscosity (Eq. 4, with the fluid's mirror images across the domain walls) and
@@ -89,13 +84,6 @@ class Fluid final : public Module {
         ParticleStore& store = state_.store;
         integrate_fluid(state_.device, step.ranges.fluid_end, store.position.view(), store.velocity.view(),
                         step.nonpressure, pressure_acc_.cview(), state_.fluid.gravity, step.dt, walls_.walls());
-        if (summarizes_) step.fluid_motion = summarize(step.ranges.fluid_end);
-    }
-
-    // The fluid's kinetic energy, top speed and first non-finite particle (a reduction read back).
-    MotionSummary summarize(std::size_t fluid_count) const {
-        return summarize_motion(state_.device, fluid_count, state_.store.position.cview(),
-                                state_.store.velocity.cview(), state_.fluid.mass);
     }
 
     bool has_viscosity() const { return has_viscosity_; }
@@ -172,7 +160,6 @@ class Fluid final : public Module {
     const BoundaryVolumes<Kernel>& volumes_;
     const WallCorrection& walls_;
     StepSizeControl& step_size_;
-    bool summarizes_ = true;
     bool has_viscosity_ = false;
     DeviceArray<Vec3> nonpressure_;   // gravity + viscosity + tension; only with one of them
     DeviceArray<Vec3> pressure_acc_;  // this iteration's pressure acceleration

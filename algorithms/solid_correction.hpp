@@ -67,7 +67,6 @@ class SolidCorrection final : public Module {
             correct_fluid_at_solids(state_.device, fluid_count, store.position.cview(), store.velocity.cview(),
                                     store.position.view(), store.velocity.view(), contact, walls_.walls());
         }
-        step.fluid_motion = fluid_.summarize(fluid_count);
     }
 
     bool active() const { return active_; }

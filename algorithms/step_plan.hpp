@@ -39,6 +39,7 @@ inline constexpr StageInfo kStepStages[] = {
     {"melting", "melting", "an object with a melting_point",
      "latent heat at the melting point; melted surface particles become fluid"},
     {"emit", "emitters", "an emitter", "the layers due by the step's end leave their discs as fluid"},
+    {"statistics", "statistics", "always", "the fluid's and the solids' kinetic energy and top speed, for stats.csv"},
 };
 inline constexpr std::size_t kStageCount = sizeof kStepStages / sizeof kStepStages[0];
 

@@ -22,6 +22,7 @@
 #include "algorithms/pcisph_delta.hpp"
 #include "algorithms/solid_bodies.hpp"
 #include "algorithms/solid_correction.hpp"
+#include "algorithms/statistics.hpp"
 #include "algorithms/step_size.hpp"
 #include "algorithms/surface_field.hpp"
 #include "algorithms/two_way_coupling.hpp"
@@ -248,13 +249,13 @@ void BackendSimulation<Kernel>::build_modules(const SimulationSetup& setup, cons
     add<FluidEmitters>(device_, setup, store, state_.counts, params_.fluid.rest_density, params_.gravity);
     search.sort_static();
     const WallCorrection& walls = add<WallCorrection>(params_, has_fluid);
-    const bool corrected = SolidCorrection<Kernel>::needed(state_, solids);
     Fluid<Kernel>& fluid = add<Fluid<Kernel>>(state_, volumes, walls, step_size_,
-                                              InterfaceTension<Kernel>::needed(has_fluid, solids), corrected);
+                                              InterfaceTension<Kernel>::needed(has_fluid, solids));
     add<InterfaceTension<Kernel>>(state_, volumes, fluid, solids);
     add<TwoWayCoupling<Kernel>>(state_, volumes, fluid, solids, search.uses_lists());
     add<SolidCorrection<Kernel>>(state_, fluid, solids, walls);
     SurfaceField<Kernel>& surface = add<SurfaceField<Kernel>>(state_, search);
+    add<Statistics<Kernel>>(state_, solids);
     search_ = &search;
     solids_ = &solids;
     heat_ = &heat;
