@@ -263,6 +263,67 @@ inline void set_region_rest_sums(LsmHostLayout& L, std::size_t r, const std::uin
     const double tr = a[0] + a[1] + a[2];
     L.region_inertia_inv[r] = regularised_inverse(tr - a[0], tr - a[1], tr - a[2], -a[3], -a[4], -a[5]);
 }
+// A particle index of a solid's lists must name a particle of the setup.
+inline void check_particle_index(std::uint32_t i, std::size_t particles, const std::string& what,
+                                 const std::string& name) {
+    if (i >= particles) throw InputError("solid '" + name + "': " + what + " index out of range");
+}
+
+// Every moving solid's GPs, linked to its IBPs by Eq. 19's normalised weights, and its SBPs on
+// their triangles of GPs (the sign makes the deformed triangle's normal point as the rest normal).
+inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const std::vector<std::size_t>& ibp_base,
+                           const std::vector<std::size_t>& sbp_base, const std::vector<std::size_t>& gp_base) {
+    const std::size_t n_particles = setup.position.size();
+    auto check_index = [&](std::uint32_t i, const std::string& what, const std::string& name) {
+        check_particle_index(i, n_particles, what, name);
+    };
+    L.gp_offsets.assign(1, 0);
+    L.gp_rest.reserve(L.gp_count);
+    L.sbp.reserve(L.sbp_count);
+    for (std::size_t o = 0; o < setup.solids.size(); ++o) {
+        const SolidSetup& s = setup.solids[o];
+        if (s.kind == SolidKind::kStatic) continue;
+        if (s.gp_offsets.size() != s.gp.size() + 1 || s.gp_links.size() != s.gp_weights.size())
+            throw InputError("solid '" + s.name + "': malformed GP links");
+        for (std::size_t g = 0; g < s.gp.size(); ++g) {
+            check_index(s.gp[g], "gp", s.name);
+            L.scene_index[L.ibp_count + L.sbp_count + gp_base[o] + g] = s.gp[g];
+            L.gp_rest.push_back(setup.position[s.gp[g]]);
+            double total = 0;
+            for (int k = s.gp_offsets[g]; k < s.gp_offsets[g + 1]; ++k) total += s.gp_weights[std::size_t(k)];
+            const int count = s.gp_offsets[g + 1] - s.gp_offsets[g];
+            if (count <= 0) throw InputError("solid '" + s.name + "': a GP has no IBP link");
+            for (int k = s.gp_offsets[g]; k < s.gp_offsets[g + 1]; ++k) {
+                const int d = s.gp_links[std::size_t(k)];
+                if (d < 0 || std::size_t(d) >= s.ibp.size()) throw InputError("solid '" + s.name + "': GP link out of range");
+                L.gp_links.push_back(std::uint32_t(ibp_base[o] + std::size_t(d)));
+                L.gp_weights.push_back(total > 0 ? Real(s.gp_weights[std::size_t(k)] / total) : Real(1.0 / count));
+            }
+            L.gp_offsets.push_back(std::uint32_t(L.gp_links.size()));
+        }
+        if (s.sbp_corners.size() != s.sbp.size() || s.sbp_barycentric.size() != s.sbp.size() ||
+            s.sbp_normal.size() != s.sbp.size())
+            throw InputError("solid '" + s.name + "': SBP lists differ in length");
+        for (std::size_t k = 0; k < s.sbp.size(); ++k) {
+            check_index(s.sbp[k], "sbp", s.name);
+            L.scene_index[L.ibp_count + sbp_base[o] + k] = s.sbp[k];
+            SbpLink link;
+            Vec3 corner[3];
+            for (int c = 0; c < 3; ++c) {
+                const int g = s.sbp_corners[k][c];
+                if (g < 0 || std::size_t(g) >= s.gp.size()) throw InputError("solid '" + s.name + "': SBP corner out of range");
+                link.corner[c] = std::uint32_t(gp_base[o] + std::size_t(g));
+                corner[c] = setup.position[s.gp[std::size_t(g)]];
+            }
+            link.bary = s.sbp_barycentric[k];
+            const Vec3 n = cross(corner[1] - corner[0], corner[2] - corner[0]);
+            link.sign = dot(n, s.sbp_normal[k]) < 0 ? Real(-1) : Real(1);
+            L.sbp.push_back(link);
+            L.sbp_normal.push_back(s.sbp_normal[k]);
+        }
+    }
+}
+
 }  // namespace lsm_detail
 
 // Builds the slot arrays and regions of every moving solid (elastic or rigid) of `setup`.
@@ -271,7 +332,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
     LsmHostLayout L;
     const std::size_t n_particles = setup.position.size();
     auto check_index = [&](std::uint32_t i, const std::string& what, const std::string& name) {
-        if (i >= n_particles) throw InputError("solid '" + name + "': " + what + " index out of range");
+        lsm_detail::check_particle_index(i, n_particles, what, name);
     };
     std::vector<std::size_t> ibp_base(setup.solids.size()), sbp_base(setup.solids.size()), gp_base(setup.solids.size());
     for (std::size_t o = 0; o < setup.solids.size(); ++o) {
@@ -388,52 +449,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
     // Rest sums per region, in double.
     for (std::size_t r = 0; r < n_regions; ++r)
         lsm_detail::set_region_rest_sums(L, r, region_members[r].data(), region_members[r].data() + region_members[r].size());
-    // GPs and SBPs.
-    L.gp_offsets.assign(1, 0);
-    L.gp_rest.reserve(L.gp_count);
-    L.sbp.reserve(L.sbp_count);
-    for (std::size_t o = 0; o < setup.solids.size(); ++o) {
-        const SolidSetup& s = setup.solids[o];
-        if (s.kind == SolidKind::kStatic) continue;
-        if (s.gp_offsets.size() != s.gp.size() + 1 || s.gp_links.size() != s.gp_weights.size())
-            throw InputError("solid '" + s.name + "': malformed GP links");
-        for (std::size_t g = 0; g < s.gp.size(); ++g) {
-            check_index(s.gp[g], "gp", s.name);
-            L.scene_index[L.ibp_count + L.sbp_count + gp_base[o] + g] = s.gp[g];
-            L.gp_rest.push_back(setup.position[s.gp[g]]);
-            double total = 0;
-            for (int k = s.gp_offsets[g]; k < s.gp_offsets[g + 1]; ++k) total += s.gp_weights[std::size_t(k)];
-            const int count = s.gp_offsets[g + 1] - s.gp_offsets[g];
-            if (count <= 0) throw InputError("solid '" + s.name + "': a GP has no IBP link");
-            for (int k = s.gp_offsets[g]; k < s.gp_offsets[g + 1]; ++k) {
-                const int d = s.gp_links[std::size_t(k)];
-                if (d < 0 || std::size_t(d) >= s.ibp.size()) throw InputError("solid '" + s.name + "': GP link out of range");
-                L.gp_links.push_back(std::uint32_t(ibp_base[o] + std::size_t(d)));
-                L.gp_weights.push_back(total > 0 ? Real(s.gp_weights[std::size_t(k)] / total) : Real(1.0 / count));
-            }
-            L.gp_offsets.push_back(std::uint32_t(L.gp_links.size()));
-        }
-        if (s.sbp_corners.size() != s.sbp.size() || s.sbp_barycentric.size() != s.sbp.size() ||
-            s.sbp_normal.size() != s.sbp.size())
-            throw InputError("solid '" + s.name + "': SBP lists differ in length");
-        for (std::size_t k = 0; k < s.sbp.size(); ++k) {
-            check_index(s.sbp[k], "sbp", s.name);
-            L.scene_index[L.ibp_count + sbp_base[o] + k] = s.sbp[k];
-            SbpLink link;
-            Vec3 corner[3];
-            for (int c = 0; c < 3; ++c) {
-                const int g = s.sbp_corners[k][c];
-                if (g < 0 || std::size_t(g) >= s.gp.size()) throw InputError("solid '" + s.name + "': SBP corner out of range");
-                link.corner[c] = std::uint32_t(gp_base[o] + std::size_t(g));
-                corner[c] = setup.position[s.gp[std::size_t(g)]];
-            }
-            link.bary = s.sbp_barycentric[k];
-            const Vec3 n = cross(corner[1] - corner[0], corner[2] - corner[0]);
-            link.sign = dot(n, s.sbp_normal[k]) < 0 ? Real(-1) : Real(1);
-            L.sbp.push_back(link);
-            L.sbp_normal.push_back(s.sbp_normal[k]);
-        }
-    }
+    lsm_detail::add_mesh_links(L, setup, ibp_base, sbp_base, gp_base);
     return L;
 }
 

@@ -15,6 +15,7 @@
 #include "apps/scene_builder.hpp"
 #include "apps/speed_limit.hpp"
 #include "apps/atomic_file.hpp"
+#include "surface/fluid_surface.hpp"
 #include "simulation/factory.hpp"
 #include "common/errors.hpp"
 
@@ -108,7 +109,23 @@ bool same_directory(const std::string& a, const std::string& b) {
 }
 }  // namespace
 
-int command_run(int argc, char** argv) {
+namespace {
+
+// The command line of `run`, read and checked.
+struct RunOptions {
+    std::vector<std::string> overrides;
+    long end_steps = 0;  // 0: run to a time
+    int threads = 0;
+    bool quiet = false;
+    long checkpoint_every = 0;
+    bool checkpoints = false;
+    std::string resume_path;  // "" for a fresh run
+    std::string requested_backend, out;
+    bool has_scene = false, has_time = false, has_out = false;
+    cxxopts::ParseResult args;
+};
+
+cxxopts::Options run_options() {
     cxxopts::Options options("meltwater run",
                              "Simulate a scene (the built-in 3D dam break when no SCENE is given) and write\n"
                              "frames/particles_NNNNN.vtu, stats.csv and summary.json into the output directory.");
@@ -125,309 +142,352 @@ int command_run(int argc, char** argv) {
                    "simulated time to reach, --steps the steps to add; --out defaults to FILE's directory",
          cxxopts::value<std::string>(), "FILE")
         ("q,quiet", "print only the final summary line and errors");
-    std::vector<std::string> overrides;
-    const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
-    if (flag_option(args, "help")) {
-        std::printf("%s\n", options.help().c_str());
-        return 0;
-    }
-    if (args.count("steps") && args.count("time")) throw InputError("--steps and --time exclude each other; give one");
-    const long end_steps = integer_option(args, "steps", 0);
-    if (args.count("steps") && end_steps < 1)
-        throw InputError("--steps must be at least 1, got " + std::to_string(end_steps));
-    const int threads = threads_option(args);
-    const bool quiet = flag_option(args, "quiet");
-    const long checkpoint_every = integer_option(args, "checkpoint-every", 0);
-    if (args.count("checkpoint-every") && checkpoint_every < 1)
-        throw InputError("--checkpoint-every must be at least 1, got " + std::to_string(checkpoint_every));
-    const bool checkpoints = flag_option(args, "checkpoint") || checkpoint_every > 0;
-    const StopSignals stop_signals;
+    return options;
+}
 
+RunOptions read_run_options(cxxopts::Options& options, int argc, char** argv) {
+    RunOptions o;
+    o.args = parse_options(options, argc, argv, &o.overrides);
+    const cxxopts::ParseResult& args = o.args;
+    if (flag_option(args, "help")) return o;
+    if (args.count("steps") && args.count("time")) throw InputError("--steps and --time exclude each other; give one");
+    o.end_steps = integer_option(args, "steps", 0);
+    if (args.count("steps") && o.end_steps < 1)
+        throw InputError("--steps must be at least 1, got " + std::to_string(o.end_steps));
+    o.threads = threads_option(args);
+    o.quiet = flag_option(args, "quiet");
+    o.checkpoint_every = integer_option(args, "checkpoint-every", 0);
+    if (args.count("checkpoint-every") && o.checkpoint_every < 1)
+        throw InputError("--checkpoint-every must be at least 1, got " + std::to_string(o.checkpoint_every));
+    o.checkpoints = flag_option(args, "checkpoint") || o.checkpoint_every > 0;
+    if (args.count("resume")) o.resume_path = args["resume"].as<std::string>();
+    o.requested_backend = args["backend"].as<std::string>();
+    o.has_scene = args.count("scene") > 0;
+    o.has_time = args.count("time") > 0;
+    o.has_out = args.count("out") > 0;
+    if (o.has_out) o.out = args["out"].as<std::string>();
+    return o;
+}
+
+// One `run`: set-up, the step loop with its frames, guards and checkpoints, and the outputs.
+class Run {
+   public:
+    explicit Run(RunOptions options) : o_(std::move(options)) {}
+    int execute();
+
+   private:
+    void resolve();                // the scene, the end, the backend and the output directory
+    bool build();                  // the setup and the simulation; false when interrupted
+    void open_outputs();           // frames, stats, the summary's fixed part
+    void print_start();
+    void write_frame();
+    void write_checkpoint_now();
+    void check_guards(const StepReport& r, Progress& progress);
+    void step_loop();
+    bool record_end();             // stats.csv and summary.json, whatever happened
+    int print_end();
+
+    RunOptions o_;
+    std::unique_ptr<Checkpoint> resume_;
+    Scene scene_;
+    double end_time_ = 0;
+    std::string backend_, checkpoint_dir_, out_dir_, stats_path_, summary_path_, checkpoint_path_;
+    long carved_fluid_ = 0;
+    SimulationSetup setup_;
+    SpeedLimit runaway_;
+    std::string emitter_warning_;
+    std::unique_ptr<Simulation> sim_;
+    bool continues_directory_ = false;
+    int frame_index_ = 0;
+    std::vector<double> frame_times_;  // of every frame up to now, for the next checkpoint
+    std::unique_ptr<FrameWriter> frames_;
+    std::unique_ptr<StatsTable> stats_;
+    RunSummary summary_;
+    std::unique_ptr<FluidSurfacer> surfacer_;
+    std::vector<double> surface_ms_, surface_field_ms_;  // per mesh: all of it, and the colour field's part
+    HostParticles host_;
+    double frame_dt_ = 0, next_frame_time_ = 0;
+    long checkpoint_step_ = -1;
+    std::chrono::steady_clock::time_point wall_start_;
+    std::exception_ptr failure_;
+    bool interrupted_ = false;
+};
+
+void Run::resolve() {
     // A resumed run takes everything the simulation is built from out of its checkpoint: the
     // scene as the first run resolved it (overrides applied, mesh paths absolute), so that the
     // setup is built exactly as it was.
-    std::unique_ptr<Checkpoint> resume;
-    std::string resume_path;
-    if (args.count("resume")) {
-        resume_path = args["resume"].as<std::string>();
-        if (args.count("scene") || !overrides.empty())
+    if (!o_.resume_path.empty()) {
+        if (o_.has_scene || !o_.overrides.empty())
             throw InputError("--resume continues the checkpoint's own scene: give no SCENE and no --set");
-        resume = std::make_unique<Checkpoint>(read_checkpoint(resume_path));
+        resume_ = std::make_unique<Checkpoint>(read_checkpoint(o_.resume_path));
     }
-    Scene scene = resume ? resolve_scene(resume->scene, "checkpoint " + resume_path)
-                         : scene_from_options(args, overrides);
-    const double end_time = number_option(args, "time", scene.end_time);
+    scene_ = resume_ ? resolve_scene(resume_->scene, "checkpoint " + o_.resume_path)
+                     : scene_from_options(o_.args, o_.overrides);
+    end_time_ = number_option(o_.args, "time", scene_.end_time);
     // The same bound as run.end_time: 1e300 s would run for ever.
-    if (args.count("time") && !(end_time > 0 && end_time <= 1e6))
-        throw InputError("--time must be in (0, 1e6] seconds, got " + format_number(end_time));
-    if (resume && end_steps == 0 && !(resume->time < end_time * (1 - 1e-9)))
-        throw InputError("the checkpoint is at t = " + format_number(resume->time) + " s, already at the end time " +
-                         format_number(end_time) + " s; give a later --time, or --steps");
+    if (o_.has_time && !(end_time_ > 0 && end_time_ <= 1e6))
+        throw InputError("--time must be in (0, 1e6] seconds, got " + format_number(end_time_));
+    if (resume_ && o_.end_steps == 0 && !(resume_->time < end_time_ * (1 - 1e-9)))
+        throw InputError("the checkpoint is at t = " + format_number(resume_->time) + " s, already at the end time " +
+                         format_number(end_time_) + " s; give a later --time, or --steps");
     // A resumed run left on auto continues on the backend that wrote the checkpoint, where that
     // backend is usable here: the backends round differently, and only the same backend continues
     // bitwise (docs/checkpoints.md). A checkpoint naming neither backend leaves auto as it is.
-    const std::string requested_backend = args["backend"].as<std::string>();
     const bool saved_backend_usable =
-        resume && (resume->backend == "openmp" || (resume->backend == "cuda" && cuda_backend_info().available));
-    const std::string backend =
-        choose_backend(requested_backend == "auto" && saved_backend_usable ? resume->backend : requested_backend);
-    if (threads > 0 && backend != "openmp" && !quiet)
+        resume_ && (resume_->backend == "openmp" || (resume_->backend == "cuda" && cuda_backend_info().available));
+    backend_ = choose_backend(o_.requested_backend == "auto" && saved_backend_usable ? resume_->backend
+                                                                                     : o_.requested_backend);
+    if (o_.threads > 0 && backend_ != "openmp" && !o_.quiet)
         std::fprintf(stderr, "meltwater: note: --threads applies to the openmp backend only\n");
-    std::string checkpoint_dir;  // of the resumed checkpoint
-    if (resume) {
-        checkpoint_dir = std::filesystem::path(resume_path).parent_path().string();
-        if (checkpoint_dir.empty()) checkpoint_dir = ".";
+    if (resume_) {
+        checkpoint_dir_ = std::filesystem::path(o_.resume_path).parent_path().string();
+        if (checkpoint_dir_.empty()) checkpoint_dir_ = ".";
     }
-    const std::string out_dir = args.count("out") ? args["out"].as<std::string>()
-                                : resume          ? checkpoint_dir
-                                                  : "results/" + (scene.name.empty() ? "run" : scene.name);
-    if (out_dir.empty()) throw InputError("--out: empty directory name");
+    out_dir_ = o_.has_out ? o_.out : resume_ ? checkpoint_dir_ : "results/" + (scene_.name.empty() ? "run" : scene_.name);
+    if (out_dir_.empty()) throw InputError("--out: empty directory name");
+    stats_path_ = out_dir_ + "/stats.csv";
+    summary_path_ = out_dir_ + "/summary.json";
+    checkpoint_path_ = out_dir_ + "/" + kCheckpointFileName;
+}
 
-    check_host_memory(scene, backend, backend == "openmp");
+bool Run::build() {
+    check_host_memory(scene_, backend_, backend_ == "openmp");
     // --threads bounds the set-up too: objects are sampled on the host's OpenMP threads.
-    if (backend == "openmp") set_host_threads(threads);
-    long carved_fluid = 0;
-    const SimulationSetup setup = build_setup(scene, &carved_fluid);
-    if (g_interrupted) return report_interrupted_setup();
-    const SpeedLimit runaway = speed_limit(scene, setup);
-    const std::string emitter_warning = emitter_overlap_warning(setup);
+    if (backend_ == "openmp") set_host_threads(o_.threads);
+    setup_ = build_setup(scene_, &carved_fluid_);
+    if (g_interrupted) return false;
+    runaway_ = speed_limit(scene_, setup_);
+    emitter_warning_ = emitter_overlap_warning(setup_);
     // Before the simulation is built, so that an unwritable --out fails at once; the directories
     // made here are removed again (if still empty) when the run ends before its first step.
-    const std::vector<std::string> created = make_directories(out_dir);
-    const std::string stats_path = out_dir + "/stats.csv", summary_path = out_dir + "/summary.json";
-    std::unique_ptr<Simulation> sim;
+    const std::vector<std::string> created = make_directories(out_dir_);
     try {
         // stats.csv and summary.json are renamed into place at the end: a directory by those
         // names would only fail then, after the whole run. A file named frames would fail when the
         // frame writer makes its directory, after the simulation (a GPU upload) is built.
-        for (const std::string& path : {stats_path, summary_path})
+        for (const std::string& path : {stats_path_, summary_path_})
             if (std::filesystem::is_directory(path))
                 throw InputError(path + " is a directory; the run writes a file there");
-        const std::string frames_path = out_dir + "/frames";
-        if (scene.writes_frames() && std::filesystem::exists(frames_path) && !std::filesystem::is_directory(frames_path))
+        const std::string frames_path = out_dir_ + "/frames";
+        if (scene_.writes_frames() && std::filesystem::exists(frames_path) && !std::filesystem::is_directory(frames_path))
             throw InputError(frames_path + " is a file; the run writes its frames in a directory there");
-        sim = create_simulation(setup, backend, threads);
-        if (resume) sim->load_state(resume->state);
+        sim_ = create_simulation(setup_, backend_, o_.threads);
+        if (resume_) sim_->load_state(resume_->state);
     } catch (...) {
         remove_created_directories(created);
         throw;
     }
     if (g_interrupted) {
         remove_created_directories(created);
-        return report_interrupted_setup();
+        return false;
     }
+    return true;
+}
 
+void Run::open_outputs() {
     // Resumed in its checkpoint's directory, the run continues that directory's frames and
     // stats.csv from the checkpoint on (what the first run wrote after it goes); elsewhere it
     // starts them afresh, its frames numbered on from the checkpoint's.
-    const bool continues_directory = resume && same_directory(out_dir, checkpoint_dir);
-    const int first_frame = resume ? static_cast<int>(resume->frame_times.size()) : 0;
-    remove_earlier_frames(out_dir, continues_directory ? first_frame : 0);
-    std::vector<double> frame_times;  // of every frame up to now, for the next checkpoint
-    if (resume) frame_times = resume->frame_times;
-    std::unique_ptr<FrameWriter> frames;
-    if (scene.writes_frames()) {
-        frames = std::make_unique<FrameWriter>(out_dir, scene.writes_vtu());
-        frames->set_objects(setup.solids);
-        if (continues_directory) frames->keep_earlier(frame_times);
+    continues_directory_ = resume_ && same_directory(out_dir_, checkpoint_dir_);
+    frame_index_ = resume_ ? static_cast<int>(resume_->frame_times.size()) : 0;
+    remove_earlier_frames(out_dir_, continues_directory_ ? frame_index_ : 0);
+    if (resume_) frame_times_ = resume_->frame_times;
+    if (scene_.writes_frames()) {
+        frames_ = std::make_unique<FrameWriter>(out_dir_, scene_.writes_vtu());
+        frames_->set_objects(setup_.solids);
+        if (continues_directory_) frames_->keep_earlier(frame_times_);
     }
-    StatsTable stats(sim->stage_names(), sim->last_report().column_names);
-    if (continues_directory) stats.keep_earlier_rows(stats_rows_up_to(stats_path, stats.header(), resume->step));
-
-    RunSummary summary;
-    summary.backend = sim->backend_name();
-    summary.device = sim->device_name();
-    summary.threads = threads;
-    summary.particles = sim->counts();
-    summary.fluid_carved = carved_fluid;
-    summary.device_bytes = sim->device_bytes();
-    summary.speed_limit = runaway.limit;
+    stats_ = std::make_unique<StatsTable>(sim_->stage_names(), sim_->last_report().column_names);
+    if (continues_directory_) stats_->keep_earlier_rows(stats_rows_up_to(stats_path_, stats_->header(), resume_->step));
+    summary_.backend = sim_->backend_name();
+    summary_.device = sim_->device_name();
+    summary_.threads = o_.threads;
+    summary_.particles = sim_->counts();
+    summary_.fluid_carved = carved_fluid_;
+    summary_.device_bytes = sim_->device_bytes();
+    summary_.speed_limit = runaway_.limit;
     char stop[64];
-    if (end_steps > 0) std::snprintf(stop, sizeof stop, "steps %ld", end_steps);
-    else std::snprintf(stop, sizeof stop, "time %g s", end_time);
-    summary.stop_condition = stop;
-    if (resume) {
-        summary.resumed_from = resume_path;
-        summary.resumed_step = resume->step;
-        summary.resumed_time = resume->time;
-        summary.simulated_time = resume->time;
+    if (o_.end_steps > 0) std::snprintf(stop, sizeof stop, "steps %ld", o_.end_steps);
+    else std::snprintf(stop, sizeof stop, "time %g s", end_time_);
+    summary_.stop_condition = stop;
+    if (resume_) {
+        summary_.resumed_from = o_.resume_path;
+        summary_.resumed_step = resume_->step;
+        summary_.resumed_time = resume_->time;
+        summary_.simulated_time = resume_->time;
     }
-
-    const std::string heat_warning =
-        heat_substeps_warning(sim->heat_substeps_needed(double(scene.params.solver.dt)), scene.params.heat.max_substeps);
-    for (const std::string& warning : {scene.kernel_warning(), heat_warning, emitter_warning}) {
+    const std::string heat_warning = heat_substeps_warning(sim_->heat_substeps_needed(double(scene_.params.solver.dt)),
+                                                           scene_.params.heat.max_substeps);
+    for (const std::string& warning : {scene_.kernel_warning(), heat_warning, emitter_warning_}) {
         if (warning.empty()) continue;
         std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
-        summary.warnings.push_back(warning);
+        summary_.warnings.push_back(warning);
     }
-    if (!quiet) {
-        const ParticleCounts& c = summary.particles;
-        // Carving changes how much fluid a scene holds: say so where the counts are given.
-        const std::string carved =
-            carved_fluid > 0 ? "; " + with_thousands(carved_fluid) + " fluid carved out where solids stand" : "";
-        const std::string pending =
-            c.by_type[kPending] > 0 ? ", " + with_thousands(c.by_type[kPending]) + " to be emitted" : "";
-        std::fprintf(stderr, "meltwater: %s (%s): %s particles (%s fluid%s, %s boundary%s) on %s [%s], %s; output in %s\n",
-                     scene.name.empty() ? "scene" : scene.name.c_str(), scene.source.c_str(),
-                     with_thousands(c.total()).c_str(), with_thousands(c.by_type[kFluid]).c_str(), pending.c_str(),
-                     with_thousands(c.total() - c.by_type[kFluid] - c.by_type[kPending]).c_str(), carved.c_str(),
-                     summary.backend.c_str(), summary.device.c_str(), stop, out_dir.c_str());
-        if (resume)
-            std::fprintf(stderr, "meltwater: resuming from %s: step %ld, t = %.6g s (written on %s)\n",
-                         resume_path.c_str(), resume->step, resume->time, resume->backend.c_str());
+    surfacer_ = std::make_unique<FluidSurfacer>(scene_.params, scene_.surface_voxel, o_.threads);
+    frame_dt_ = 1.0 / scene_.fps;
+    next_frame_time_ = resume_ ? resume_->next_frame_time : frame_dt_;
+}
+
+void Run::print_start() {
+    if (o_.quiet) return;
+    const ParticleCounts& c = summary_.particles;
+    // Carving changes how much fluid a scene holds: say so where the counts are given.
+    const std::string carved =
+        carved_fluid_ > 0 ? "; " + with_thousands(carved_fluid_) + " fluid carved out where solids stand" : "";
+    const std::string pending =
+        c.by_type[kPending] > 0 ? ", " + with_thousands(c.by_type[kPending]) + " to be emitted" : "";
+    std::fprintf(stderr, "meltwater: %s (%s): %s particles (%s fluid%s, %s boundary%s) on %s [%s], %s; output in %s\n",
+                 scene_.name.empty() ? "scene" : scene_.name.c_str(), scene_.source.c_str(),
+                 with_thousands(c.total()).c_str(), with_thousands(c.by_type[kFluid]).c_str(), pending.c_str(),
+                 with_thousands(c.total() - c.by_type[kFluid] - c.by_type[kPending]).c_str(), carved.c_str(),
+                 summary_.backend.c_str(), summary_.device.c_str(), summary_.stop_condition.c_str(), out_dir_.c_str());
+    if (resume_)
+        std::fprintf(stderr, "meltwater: resuming from %s: step %ld, t = %.6g s (written on %s)\n",
+                     o_.resume_path.c_str(), resume_->step, resume_->time, resume_->backend.c_str());
+}
+
+void Run::write_frame() {
+    if (!frames_) return;
+    sim_->download(host_);
+    frames_->write(frame_index_, host_, sim_->time());
+    if (scene_.writes_surface()) {
+        const FluidSurfacer::Surface surface = surfacer_->build(*sim_, host_);
+        frames_->write_surface(frame_index_, surface.mesh);
+        surface_ms_.push_back(surface.ms);
+        surface_field_ms_.push_back(surface.field_ms);
+        summary_.surfaces = static_cast<int>(surface_ms_.size());
+        summary_.surface_ms_median = median_of(surface_ms_);
+        summary_.surface_field_ms_median = median_of(surface_field_ms_);
+        summary_.surface_triangles_last = static_cast<long>(surface.mesh.triangles.size());
     }
+    frame_times_.push_back(sim_->time());
+    ++frame_index_;
+}
 
-    const auto wall_start = std::chrono::steady_clock::now();
-    auto last_stats_write = wall_start;
-    double stats_write_seconds = 0;  // how long the last rewrite of stats.csv took
-    HostParticles host;
-    int frame_index = first_frame;
-    std::vector<double> surface_ms, surface_field_ms;  // per mesh: all of it, and the colour field's part
-    FluidSurfacer surfacer(scene.params, scene.surface_voxel, threads);
-    auto write_frame = [&]() {
-        if (!frames) return;
-        sim->download(host);
-        frames->write(frame_index, host, sim->time());
-        if (scene.writes_surface()) {
-            const FluidSurfacer::Surface surface = surfacer.build(*sim, host);
-            frames->write_surface(frame_index, surface.mesh);
-            surface_ms.push_back(surface.ms);
-            surface_field_ms.push_back(surface.field_ms);
-            summary.surfaces = static_cast<int>(surface_ms.size());
-            summary.surface_ms_median = median_of(surface_ms);
-            summary.surface_field_ms_median = median_of(surface_field_ms);
-            summary.surface_triangles_last = static_cast<long>(surface.mesh.triangles.size());
-        }
-        frame_times.push_back(sim->time());
-        ++frame_index;
-    };
-    const double frame_dt = 1.0 / scene.fps;
-    double next_frame_time = resume ? resume->next_frame_time : frame_dt;
-    // The checkpoint: the state now, with the scene and the frame clock (checkpoint_file.hpp).
-    const std::string checkpoint_path = out_dir + "/" + kCheckpointFileName;
-    long checkpoint_step = -1;
-    auto write_checkpoint_now = [&]() {
-        Checkpoint c;
-        c.scene = scene.resolved;
-        c.backend = summary.backend;
-        c.step = sim->last_report().step;
-        c.time = sim->time();
-        c.frame_times = frame_times;
-        c.next_frame_time = next_frame_time;
-        sim->save_state(c.state);
-        write_checkpoint(checkpoint_path, c);
-        checkpoint_step = c.step;
-        summary.checkpoint = checkpoint_path;
-        summary.checkpoint_step = c.step;
-    };
+// The checkpoint: the state now, with the scene and the frame clock (checkpoint_file.hpp).
+void Run::write_checkpoint_now() {
+    Checkpoint c;
+    c.scene = scene_.resolved;
+    c.backend = summary_.backend;
+    c.step = sim_->last_report().step;
+    c.time = sim_->time();
+    c.frame_times = frame_times_;
+    c.next_frame_time = next_frame_time_;
+    sim_->save_state(c.state);
+    write_checkpoint(checkpoint_path_, c);
+    checkpoint_step_ = c.step;
+    summary_.checkpoint = checkpoint_path_;
+    summary_.checkpoint_step = c.step;
+}
 
-    std::exception_ptr failure;
-    bool interrupted = false;
-    try {
-        if (!resume) write_frame();  // frame 0: the initial state (a resumed run has its frames)
-        Progress progress(quiet ? Progress::Mode::kQuiet : Progress::Mode::kAuto, end_steps, end_time,
-                          resume ? resume->step : 0, resume ? resume->time : 0.0);
-        long steps_done = 0;
-        // Stop at the step that reaches end_time (to a relative tolerance, so 0.1 + 0.1 + ... counts).
-        while (end_steps > 0 ? steps_done < end_steps : sim->time() < end_time * (1 - 1e-9)) {
-            if (g_interrupted) {
-                interrupted = true;
-                break;
-            }
-            try {
-                sim->step();
-            } catch (const DeviceError& e) {
-                // A step can still allocate (neighbour lists growing as the flow compresses):
-                // say where the run stood and what it held.
-                progress.finish();
-                throw DeviceError(std::string(e.what()) + " (in step " + std::to_string(steps_done + 1) + "; the " +
-                                  with_thousands(long(summary.particles.total())) + " particles held " +
-                                  format_bytes(double(summary.device_bytes)) + " before it)");
-            } catch (...) {
-                progress.finish();
-                throw;
-            }
-            ++steps_done;
-            const StepReport& r = sim->last_report();
-            stats.add(r);
-            summary.steps = steps_done;
-            summary.simulated_time = r.time;
-            summary.lost_particles = r.lost_particles;
-            progress.update(r);
-            // Against the fluid there is now: melting objects add to it (the counts are host figures).
-            const long fluid_now = sim->counts().by_type[kFluid];
-            if (r.lost_particles > scene.max_lost_fraction * double(fluid_now)) {
-                progress.finish();
-                throw SimulationError(lost_fluid_message(r, fluid_now, stats, scene));
-            }
-            if (r.density_error_max > scene.max_density_error) {
-                progress.finish();
-                throw SimulationError(density_blowup_message(r, stats, scene));
-            }
-            if (runaway.limit > 0 && std::max(r.max_speed, r.solid_max_speed) > runaway.limit) {
-                progress.finish();
-                throw SimulationError(runaway_message(r, runaway, stats));
-            }
-            if (r.time >= next_frame_time * (1 - 1e-9)) {
-                write_frame();
-                // The next frame time after now (a step longer than 1/fps skips frame times).
-                next_frame_time = (std::floor(r.time / frame_dt * (1 + 1e-9)) + 1) * frame_dt;
-            }
-            if (checkpoint_every > 0 && r.step % checkpoint_every == 0) write_checkpoint_now();
-            // Keep stats.csv current for a run that dies: every 5 s, or less often once the file
-            // is so long that rewriting it would take more than 5% of the run.
-            if (seconds_since(last_stats_write) > std::max(5.0, 20 * stats_write_seconds)) {
-                const auto write_start = std::chrono::steady_clock::now();
-                stats.write(stats_path);
-                stats_write_seconds = seconds_since(write_start);
-                last_stats_write = std::chrono::steady_clock::now();
-            }
-        }
+// The run stops at the step that passes a guard (docs/running.md).
+void Run::check_guards(const StepReport& r, Progress& progress) {
+    // Against the fluid there is now: melting objects add to it (the counts are host figures).
+    const long fluid_now = sim_->counts().by_type[kFluid];
+    if (r.lost_particles > scene_.max_lost_fraction * double(fluid_now)) {
         progress.finish();
-    } catch (...) {
-        failure = std::current_exception();
+        throw SimulationError(lost_fluid_message(r, fluid_now, *stats_, scene_));
     }
+    if (r.density_error_max > scene_.max_density_error) {
+        progress.finish();
+        throw SimulationError(density_blowup_message(r, *stats_, scene_));
+    }
+    if (runaway_.limit > 0 && std::max(r.max_speed, r.solid_max_speed) > runaway_.limit) {
+        progress.finish();
+        throw SimulationError(runaway_message(r, runaway_, *stats_));
+    }
+}
 
+void Run::step_loop() {
+    auto last_stats_write = wall_start_;
+    double stats_write_seconds = 0;  // how long the last rewrite of stats.csv took
+    if (!resume_) write_frame();     // frame 0: the initial state (a resumed run has its frames)
+    Progress progress(o_.quiet ? Progress::Mode::kQuiet : Progress::Mode::kAuto, o_.end_steps, end_time_,
+                      resume_ ? resume_->step : 0, resume_ ? resume_->time : 0.0);
+    long steps_done = 0;
+    // Stop at the step that reaches end_time (to a relative tolerance, so 0.1 + 0.1 + ... counts).
+    while (o_.end_steps > 0 ? steps_done < o_.end_steps : sim_->time() < end_time_ * (1 - 1e-9)) {
+        if (g_interrupted) {
+            interrupted_ = true;
+            break;
+        }
+        try {
+            sim_->step();
+        } catch (const DeviceError& e) {
+            // A step can still allocate (neighbour lists growing as the flow compresses): say where
+            // the run stood and what it held.
+            progress.finish();
+            throw DeviceError(std::string(e.what()) + " (in step " + std::to_string(steps_done + 1) + "; the " +
+                              with_thousands(long(summary_.particles.total())) + " particles held " +
+                              format_bytes(double(summary_.device_bytes)) + " before it)");
+        } catch (...) {
+            progress.finish();
+            throw;
+        }
+        ++steps_done;
+        const StepReport& r = sim_->last_report();
+        stats_->add(r);
+        summary_.steps = steps_done;
+        summary_.simulated_time = r.time;
+        summary_.lost_particles = r.lost_particles;
+        progress.update(r);
+        check_guards(r, progress);
+        if (r.time >= next_frame_time_ * (1 - 1e-9)) {
+            write_frame();
+            // The next frame time after now (a step longer than 1/fps skips frame times).
+            next_frame_time_ = (std::floor(r.time / frame_dt_ * (1 + 1e-9)) + 1) * frame_dt_;
+        }
+        if (o_.checkpoint_every > 0 && r.step % o_.checkpoint_every == 0) write_checkpoint_now();
+        // Keep stats.csv current for a run that dies: every 5 s, or less often once the file is so
+        // long that rewriting it would take more than 5% of the run.
+        if (seconds_since(last_stats_write) > std::max(5.0, 20 * stats_write_seconds)) {
+            const auto write_start = std::chrono::steady_clock::now();
+            stats_->write(stats_path_);
+            stats_write_seconds = seconds_since(write_start);
+            last_stats_write = std::chrono::steady_clock::now();
+        }
+    }
+    progress.finish();
+}
+
+bool Run::record_end() {
     // A run that ended or was stopped leaves its checkpoint (one that failed does not: its state
     // is what failed).
-    if (!failure && checkpoints && checkpoint_step != sim->last_report().step) {
+    if (!failure_ && o_.checkpoints && checkpoint_step_ != sim_->last_report().step) {
         try {
             write_checkpoint_now();
         } catch (...) {
-            failure = std::current_exception();
+            failure_ = std::current_exception();
         }
     }
-    summary.wall_seconds = seconds_since(wall_start);
-    summary.frames = frames ? frames->written() : 0;
-    if (failure) {
-        summary.status = "failed";
+    summary_.wall_seconds = seconds_since(wall_start_);
+    summary_.frames = frames_ ? frames_->written() : 0;
+    if (failure_) {
+        summary_.status = "failed";
         try {
-            std::rethrow_exception(failure);
+            std::rethrow_exception(failure_);
         } catch (const std::exception& e) {
-            summary.error = e.what();
+            summary_.error = e.what();
         }
-    } else if (interrupted) {
-        summary.status = "interrupted";
+    } else if (interrupted_) {
+        summary_.status = "interrupted";
     }
     // Whatever happened, leave whole stats.csv and summary.json behind.
-    bool recorded = true;
     try {
-        stats.write(stats_path);
-        write_summary(summary_path, summary, stats, scene);
+        stats_->write(stats_path_);
+        write_summary(summary_path_, summary_, *stats_, scene_);
     } catch (const std::exception& e) {
-        if (!failure) throw;
-        recorded = false;
+        if (!failure_) throw;
         std::fprintf(stderr, "meltwater: error: could not record the failure: %s\n", e.what());
+        return false;
     }
-    if (failure) {
-        std::fprintf(stderr, "meltwater: stopped after %s at t=%.4g s; %s%s kept in %s\n",
-                     count_of(summary.steps, "step").c_str(), summary.simulated_time,
-                     count_of(summary.frames, "frame").c_str(), recorded ? ", stats.csv and summary.json" : "",
-                     out_dir.c_str());
-        std::rethrow_exception(failure);
-    }
+    return true;
+}
 
-    if (stats.retried_steps() > 0 && !quiet)
+int Run::print_end() {
+    const StatsTable& stats = *stats_;
+    if (stats.retried_steps() > 0 && !o_.quiet)
         std::fprintf(stderr,
                      "meltwater: note: %s taken again at a smaller dt because PCISPH diverged or ran out of "
                      "iterations (column dt_retries of stats.csv; docs/solver.md, \"Time step\")\n",
@@ -441,37 +501,70 @@ int command_run(int argc, char** argv) {
         std::fprintf(stderr,
                      "meltwater: warning: in %s PCISPH ran out of iterations (solver.max_iterations %d) above its "
                      "tolerance and the step was integrated anyway (column unconverged of stats.csv)%s\n",
-                     count_of(stats.unconverged_steps(), "step").c_str(), scene.params.solver.max_iterations,
-                     scene.params.solver.dt_mode == TimeStepMode::kCfl
+                     count_of(stats.unconverged_steps(), "step").c_str(), scene_.params.solver.max_iterations,
+                     scene_.params.solver.dt_mode == TimeStepMode::kCfl
                          ? "; halving the step (up to six times) did not rescue them: raise solver.max_iterations, or "
                            "loosen solver.eta or solver.eta_max"
                          : "; use a smaller dt, more iterations, or dt_mode \"cfl\"");
-    if (summary.lost_particles > 0)
+    if (summary_.lost_particles > 0)
         std::fprintf(stderr, "meltwater: warning: %s left the domain (column lost_particles of stats.csv)\n",
-                     count_of(summary.lost_particles, "fluid particle").c_str());
+                     count_of(summary_.lost_particles, "fluid particle").c_str());
     std::error_code ec;
-    const std::string shown = std::filesystem::absolute(out_dir, ec).lexically_normal().string();
+    const std::string shown = std::filesystem::absolute(out_dir_, ec).lexically_normal().string();
     // The fluid's figures mean nothing in a scene without fluid (all zero): say so instead.
     char fluid_figures[160] = "no fluid";
-    if (summary.particles.by_type[kFluid] > 0 || stats.has_column("melted") || stats.has_column("emitted"))
+    if (summary_.particles.by_type[kFluid] > 0 || stats.has_column("melted") || stats.has_column("emitted"))
         std::snprintf(fluid_figures, sizeof fluid_figures, "density error avg %.3g%% max %.3g%%, %.1f iterations/step",
                       100 * stats.density_error_avg(), 100 * stats.density_error_max(), stats.iterations_avg());
     std::printf("meltwater: %s %s to t=%.4g s in %.1f s (%.1f ms/step median, %s)\n",
-                interrupted ? "interrupted after" : "ran", count_of(summary.steps, "step").c_str(),
-                summary.simulated_time, summary.wall_seconds,
-                stats.median_total_ms(), fluid_figures);
-    const std::string surfaces =
-        summary.surfaces > 0 ? " and " + count_of(summary.surfaces, "surface") + " (" +
-                                   format_number(summary.surface_ms_median) + " ms each)"
-                             : "";
+                interrupted_ ? "interrupted after" : "ran", count_of(summary_.steps, "step").c_str(),
+                summary_.simulated_time, summary_.wall_seconds, stats.median_total_ms(), fluid_figures);
+    const std::string surfaces = summary_.surfaces > 0 ? " and " + count_of(summary_.surfaces, "surface") + " (" +
+                                                             format_number(summary_.surface_ms_median) + " ms each)"
+                                                       : "";
     std::printf("meltwater: results in %s (%s%s in frames/, stats.csv, summary.json%s)\n",
-                ec ? out_dir.c_str() : shown.c_str(), count_of(summary.frames, "frame").c_str(), surfaces.c_str(),
-                summary.checkpoint.empty() ? "" : ", checkpoint.mwc");
-    if (!summary.checkpoint.empty() && !quiet)
+                ec ? out_dir_.c_str() : shown.c_str(), count_of(summary_.frames, "frame").c_str(), surfaces.c_str(),
+                summary_.checkpoint.empty() ? "" : ", checkpoint.mwc");
+    if (!summary_.checkpoint.empty() && !o_.quiet)
         std::fprintf(stderr, "meltwater: checkpoint at step %ld (t = %.6g s); continue with: meltwater run --resume %s "
-                     "--time T\n", summary.checkpoint_step, summary.simulated_time, summary.checkpoint.c_str());
+                     "--time T\n", summary_.checkpoint_step, summary_.simulated_time, summary_.checkpoint.c_str());
     std::fflush(stdout);
-    return interrupted ? 130 : 0;
+    return interrupted_ ? 130 : 0;
+}
+
+int Run::execute() {
+    const StopSignals stop_signals;
+    resolve();
+    if (!build()) return report_interrupted_setup();
+    open_outputs();
+    print_start();
+    wall_start_ = std::chrono::steady_clock::now();
+    try {
+        step_loop();
+    } catch (...) {
+        failure_ = std::current_exception();
+    }
+    const bool recorded = record_end();
+    if (failure_) {
+        std::fprintf(stderr, "meltwater: stopped after %s at t=%.4g s; %s%s kept in %s\n",
+                     count_of(summary_.steps, "step").c_str(), summary_.simulated_time,
+                     count_of(summary_.frames, "frame").c_str(), recorded ? ", stats.csv and summary.json" : "",
+                     out_dir_.c_str());
+        std::rethrow_exception(failure_);
+    }
+    return print_end();
+}
+
+}  // namespace
+
+int command_run(int argc, char** argv) {
+    cxxopts::Options options = run_options();
+    RunOptions o = read_run_options(options, argc, argv);
+    if (flag_option(o.args, "help")) {
+        std::printf("%s\n", options.help().c_str());
+        return 0;
+    }
+    return Run(std::move(o)).execute();
 }
 
 }  // namespace mw

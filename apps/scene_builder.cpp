@@ -162,6 +162,38 @@ long estimate_particle_count(const Scene& scene) {
     return n > 1e18 ? static_cast<long>(1e18) : static_cast<long>(n);
 }
 
+namespace {
+
+// With heat conduction, every particle added since the last call starts at `t` (C).
+void start_new_particles_at(const Scene& scene, SimulationSetup& setup, Real t) {
+    if (scene.params.heat.enabled) setup.temperature.resize(setup.position.size(), t);
+}
+
+// The emitters' particles, pending until their layer leaves (algorithms/emitter.hpp), last so
+// that nothing before them renumbers them.
+void add_emitters(const Scene& scene, SimulationSetup& setup) {
+    const Real r0 = scene.params.fluid.spacing;
+    for (std::size_t k = 0; k < scene.emitters.size(); ++k) {
+        const SceneEmitter& e = scene.emitters[k];
+        EmitterSetup emitter;
+        static_cast<EmitterParams&>(emitter) = e;
+        emitter.name = e.name;
+        emitter.offsets = disc_lattice(e.direction, e.radius, r0);
+        emitter.layers = emitter_layers(e, r0);
+        emitter.first = static_cast<std::uint32_t>(setup.position.size());
+        const double count = double(emitter.layers) * double(emitter.offsets.size());
+        if (double(setup.position.size()) + count > double(kMaxSceneParticles))
+            throw InputError(scene.source + ": emitters[" + std::to_string(k) + "] (" + e.name + ") would release " +
+                             std::to_string(static_cast<long>(count)) + " particles, more than the scene allows (" +
+                             std::to_string(kMaxSceneParticles) + " in all); shorten it, slow it or narrow it");
+        append(setup, std::vector<Vec3>(std::size_t(count), e.center), Vec3{0, 0, 0}, kPending, -1);
+        start_new_particles_at(scene, setup, e.temperature);
+        setup.emitters.push_back(std::move(emitter));
+    }
+}
+
+}  // namespace
+
 SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     const long estimate = estimate_particle_count(scene);
     if (estimate > kMaxSceneParticles)
@@ -172,10 +204,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     setup.params = scene.params;
     const Real r0 = scene.params.fluid.spacing;
     std::vector<std::size_t> block_end;  // fluid_blocks[i] fills [block_end[i - 1], block_end[i])
-    // With heat conduction, every particle added since the last call starts at `t` (°C).
-    const auto started_at = [&](Real t) {
-        if (scene.params.heat.enabled) setup.temperature.resize(setup.position.size(), t);
-    };
+    const auto started_at = [&](Real t) { start_new_particles_at(scene, setup, t); };
     for (std::size_t i = 0; i < scene.fluid_blocks.size(); ++i) {
         const FluidBlock& b = scene.fluid_blocks[i];
         const std::vector<Vec3> points = fill_box_lattice(b.min, b.max, r0);
@@ -288,29 +317,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         }
     }
     if (carved_fluid) *carved_fluid = carved;
-    // The emitters' particles, pending until their layer leaves (algorithms/emitter.hpp), last so
-    // that nothing above renumbers them.
-    for (std::size_t k = 0; k < scene.emitters.size(); ++k) {
-        const SceneEmitter& e = scene.emitters[k];
-        EmitterSetup emitter;
-        emitter.name = e.name;
-        emitter.center = e.center;
-        emitter.direction = e.direction;
-        emitter.speed = e.speed;
-        emitter.start = e.start;
-        emitter.temperature = e.temperature;
-        emitter.offsets = disc_lattice(e.direction, e.radius, r0);
-        emitter.layers = emitter_layers(e, r0);
-        emitter.first = static_cast<std::uint32_t>(setup.position.size());
-        const double count = double(emitter.layers) * double(emitter.offsets.size());
-        if (double(setup.position.size()) + count > double(kMaxSceneParticles))
-            throw InputError(scene.source + ": emitters[" + std::to_string(k) + "] (" + e.name + ") would release " +
-                             std::to_string(static_cast<long>(count)) + " particles, more than the scene allows (" +
-                             std::to_string(kMaxSceneParticles) + " in all); shorten it, slow it or narrow it");
-        append(setup, std::vector<Vec3>(std::size_t(count), e.center), Vec3{0, 0, 0}, kPending, -1);
-        started_at(e.temperature);
-        setup.emitters.push_back(std::move(emitter));
-    }
+    add_emitters(scene, setup);
     return setup;
 }
 
