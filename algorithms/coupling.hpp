@@ -1,4 +1,4 @@
-// Two-way coupling, the fluid's side of it (METHOD.md, step 5): every force a moving solid's
+// Two-way coupling, the fluid's side of it (docs/method.md, "Two-way coupling"): every force a moving solid's
 // boundary particle exerted on the fluid in this step goes back to the solid, reversed, and
 // reaches its IBPs, which LSM moves.
 //
@@ -17,7 +17,7 @@
 //    of the interpolation that moves the SBPs (an SBP follows its triangle's GPs by barycentric
 //    weights, a GP its linked IBPs by Eq. 19's normalised weights): an SBP's shares sum to 1, so
 //    no force is lost or made, and the work the force does on the SBP is the work its shares do
-//    on the IBPs, up to Eq. 19's rotation term. METHOD.md's Eq. 10 as printed,
+//    on the IBPs, up to Eq. 19's rotation term. docs/method.md's Eq. 10 as printed,
 //    F_d = Σ_s W(x_ds) F_s / Σ_s W(x_ds), averages instead of sharing: an IBP next to n SBPs
 //    takes about one SBP's force, not n shares of theirs, so the total on a body is not the sum
 //    of its SBPs' forces (docs/coupling.md).

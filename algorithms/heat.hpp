@@ -1,4 +1,4 @@
-// Heat conduction between fluid and moving solids: the first half of melting (METHOD.md,
+// Heat conduction between fluid and moving solids: the first half of melting (docs/method.md,
 // "Melting"; docs/heat.md). Every fluid particle and every surface and inner particle of an
 // elastic or rigid object carries a temperature T; static walls, static boxes and static objects
 // are adiabatic (no heat crosses them) and the mesh vertices (GPs) keep their initial value.
@@ -32,10 +32,10 @@
 // its neighbours' weighted mean instead of past it: the update stays a mean, stable at any Δt,
 // but that particle's exchange is no longer symmetric, so it conserves heat only approximately.
 //
-// METHOD.md's backward Euler (one pass per step, stable at any Δt) was built first, as Jacobi
-// sweeps of the implicit system: one sweep diffuses at 1/(1 + D) of the true rate (0.56 at a
-// Fourier number α Δt / r0² of 0.2, 0.21 at 1), and reaching 5% took 4 sweeps at 0.2 and 28 at 2
-// (then about 11% slow). Explicit sub-steps are within 1% of the true rate at every Fourier number
+// Why not the paper's backward Euler (one pass per step, stable at any Δt): solved by Jacobi sweeps
+// of the implicit system, one sweep diffuses at 1/(1 + D) of the true rate (0.56 at a Fourier
+// number α Δt / r0² of 0.2, 0.21 at 1), and reaching 5% takes 4 sweeps at 0.2 and 28 at 2 (then
+// about 11% slow). Explicit sub-steps are within 1% of the true rate at every Fourier number
 // tried, in 1 pass at 0.2 and 9 at 2 (tests/core/test_heat.cpp, docs/heat.md).
 #pragma once
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Interface tension between fluid and moving solids (the paper's Eq. 9, after [IUD10]; METHOD.md
+// Interface tension between fluid and moving solids (the paper's Eq. 9, after [IUD10]; docs/method.md
 // step 3): a fluid particle i within h of a surface particle s (SBP) of an object whose
 // `interface_tension` η_s is not 0 is drawn toward it,
 //

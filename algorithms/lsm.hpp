@@ -1,6 +1,6 @@
 // Lattice shape matching, per-step part (device): region sums and rotations, then goals and the
 // velocity/position update of every IBP. Data layout: lsm_regions.hpp; the class that owns the
-// arrays and calls these stages: solid_bodies.hpp. The algebra (METHOD.md, "Lattice shape
+// arrays and calls these stages: solid_bodies.hpp. The algebra (docs/method.md, "Lattice shape
 // matching"), written in displacements u = x - x0 so that nothing cancels catastrophically in
 // float and a body at rest stays bitwise at rest:
 //   c_r = c0_r + ū_r,            ū_r = u_a + Σ m̃ (u - u_a) / M_r   (u_a: one member's, the anchor)

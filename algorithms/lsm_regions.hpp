@@ -5,7 +5,7 @@
 // re-sorts particles every step; a slot never changes, so all LSM data below is indexed by slot
 // and a per-step map slot -> store index finds the particle.
 //
-// Regions (METHOD.md, "Lattice shape matching"): an elastic object has one region per IBP,
+// Regions (docs/method.md, "Lattice shape matching"): an elastic object has one region per IBP,
 // centred on it, holding the IBPs within w lattice links, i.e. those reachable from the centre in
 // at most w steps through existing lattice neighbours (26-neighbourhood). Where the whole
 // (2w+1)³ cube exists this is the cube; elsewhere a breadth-first search keeps regions from
@@ -455,7 +455,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
 
 // Per lattice vertex, how many of its 26 one-ring neighbours are present (among the `alive` ones
 // when given: per vertex, 0 for a gone one). A melting object's vertex with all 26 is an IBP,
-// any other an SBP (METHOD.md, "Particles").
+// any other an SBP (docs/method.md, "Particles").
 inline std::vector<std::uint8_t> lattice_one_ring_counts(const std::vector<std::array<int, 3>>& lattice,
                                                          const std::vector<std::uint8_t>& alive = {}) {
     std::vector<std::uint8_t> count(lattice.size(), 0);

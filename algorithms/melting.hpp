@@ -1,4 +1,4 @@
-// Melting, the second half (METHOD.md, "Melting"; docs/melting.md): phase change, outside in.
+// Melting, the second half (docs/method.md, "Melting"; docs/melting.md): phase change, outside in.
 // Heat conduction (heat.hpp) brings the temperatures; this stage, once a step after the fluid's
 // integration, turns a melting object's surface particles into fluid.
 //
@@ -20,8 +20,8 @@
 //   map, which every per-slot kernel skips.
 // The step's melt flags are a reduction read back (one synchronisation a step, in scenes with a
 // melting object); the rebuild is host work and a copy of the region arrays, on the steps where
-// something melted only. METHOD.md does the rebuild on the device, by w + 1 rounds of one-ring
-// filling; that is the next step if it shows in the timings (docs/melting.md).
+// something melted only. On the device it would take w + 1 rounds of one-ring filling
+// (docs/melting.md).
 #pragma once
 #include <algorithm>
 #include <cmath>

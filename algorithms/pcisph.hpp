@@ -1,4 +1,4 @@
-// PCISPH (Solenthaler & Pajarola 2009) with Akinci boundary particles, as in METHOD.md, written
+// PCISPH (Solenthaler & Pajarola 2009) with Akinci boundary particles, as in docs/method.md, written
 // once against the backend abstraction. Every stage is a gather: particle i reads its neighbours
 // and writes only itself, so results do not depend on thread scheduling.
 //

@@ -1,6 +1,6 @@
-// The moving solids of a simulation (elastic and rigid objects) on one backend: their LSM state,
-// the stable slot of each solid particle, and the per-step work (METHOD.md, step 6), called once
-// per step from time_step.hpp.
+// The solids module: the moving solids of a simulation (elastic and rigid objects) on one backend,
+// their LSM state, the stable slot of each solid particle, and the per-step work (docs/method.md,
+// "Lattice shape matching"; stage "lsm").
 //
 // Slots: the particle store re-sorts particles every step, so every solid particle (IBP, SBP,
 // GP) carries its fixed slot in a persistent store field `solid_slot` (-1 for others), and after

@@ -1,4 +1,4 @@
-// The velocity–position correction against moving solids (METHOD.md step 7; the paper's §3.3,
+// The velocity–position correction against moving solids (docs/method.md; the paper's §3.3,
 // Eqs. 11-17), after the fluid's integration: a fluid particle near an elastic or rigid object's
 // surface particles (SBPs) faces the virtual boundary particle k built from those within r0
 // (virtual_boundary.hpp); when it lies within the band c of k's surface and moves into it, it
@@ -14,7 +14,7 @@
 //           lattice) gives v̂ⁿ_i = vⁿ_k exactly
 //   the solid: gets the impulse J = -m_i Δv_i, shared among the SBPs k was built from by
 //           w_s / Σ w (the paper's Eq. 18 projects the change on each SBP's velocity, which is
-//           undefined for an SBP at rest; METHOD.md). Each SBP gathers its shares from the fluid
+//           undefined for an SBP at rest; docs/method.md). Each SBP gathers its shares from the fluid
 //           particles within r0 of it, with the same weights on the same numbers, so the shares
 //           add up to J.
 //

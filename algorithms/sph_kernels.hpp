@@ -12,7 +12,7 @@ namespace mw {
 constexpr Real kPi = Real(3.14159265358979323846);
 
 // The scene's choice of smoothing kernel for the fluid (`fluid.kernel`).
-//  - cubic spline (Monaghan): METHOD.md's kernel (the paper says only "a Gaussian-like kernel
+//  - cubic spline (Monaghan): docs/method.md's kernel (the paper says only "a Gaussian-like kernel
 //    with finite support radius h"), the default.
 //  - Wendland C2 (Wendland 1995): no pairing instability at any neighbour count (Dehnen & Aly
 //    2012). The cubic spline has one at wide supports: at the paper's h = 2.5 r0 (about 65

@@ -1,5 +1,5 @@
 // The virtual boundary particle of the velocity–position correction against moving solids (the
-// paper's Eq. 11; METHOD.md step 7): what a fluid particle collides with when it comes too close
+// paper's Eq. 11; docs/method.md): what a fluid particle collides with when it comes too close
 // to an elastic or rigid object's surface particles (SBPs). Read by the correction after the
 // integration (solid_contact.hpp) and by its position rule inside the PCISPH loop (pcisph.hpp).
 //

@@ -1,8 +1,8 @@
-// The velocity–position correction against static boundaries: METHOD.md's step 7 (and its
-// position rule inside the PCISPH loop) for a boundary that does not move and whose mass is
-// infinite. Three kinds of static boundary whose surfaces are known exactly: the domain walls,
-// the static boxes, and static mesh objects through their signed distance grids
-// (distance_field.hpp, sampling/signed_distance.hpp).
+// The velocity–position correction against static boundaries (docs/method.md, "The
+// velocity–position correction"), and its position rule inside the PCISPH loop, for a boundary
+// that does not move and whose mass is infinite. Three kinds of static boundary whose surfaces are
+// known exactly: the domain walls, the static boxes, and static mesh objects through their signed
+// distance grids (distance_field.hpp, sampling/signed_distance.hpp).
 //
 // Why: a single Akinci layer repels a fluid particle less and less as it comes close to the layer
 // (the layer's gradients cancel in its own plane), so a particle driven hard enough into a wall

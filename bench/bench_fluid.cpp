@@ -674,7 +674,7 @@ int main(int argc, char** argv) {
                            "fluid particles, 3.6k SBPs, 16.3k IBPs) on a GTX 690, with no separate figure for the phase "
                            "change.\n\n");
         }
-        // The paper's Table 2 (METHOD.md), the rows the product can run. Fig. 8: the stages'
+        // The paper's Table 2 (docs/method.md), the rows the product can run. Fig. 8: the stages'
         // medians over the steps after the stream has brought 20,000 fluid particles.
         if (o.wants("paper")) {
             const std::string mesh = std::string(MW_SOURCE_DIR) + "/../shared/assets/meshes/stanford-bunny.obj";

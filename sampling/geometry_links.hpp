@@ -1,5 +1,5 @@
 // GPs: the mesh vertices, each linked to the IBPs within the support radius h in the rest shape,
-// with cubic-spline kernel weights, ready for the GP interpolation (METHOD.md, Eq. 19):
+// with cubic-spline kernel weights, ready for the GP interpolation (docs/method.md, Eq. 19):
 //   x_g = Σ_d W(x0_gd) (R_d x0_gd + g_d) / Σ_d W(x0_gd).
 #pragma once
 #include <cmath>

@@ -5,7 +5,7 @@
 // Why a grid and not the object's particles: a static object never moves, so its distance can be
 // computed once, exactly, from its mesh. The correction then knows the surface and its normal
 // everywhere near it and inside it, at one trilinear lookup per particle, including a particle that
-// a large step has carried past the object's surface particles (the particles' band, METHOD.md
+// a large step has carried past the object's surface particles (the particles' band, docs/method.md
 // step 7, only reaches r0 into the solid).
 //
 // How: the sign comes from the inside/outside classification of the samplers (inside_outside.hpp:

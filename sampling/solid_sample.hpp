@@ -1,5 +1,5 @@
 // Meshes to particles: one call turns a solid's triangle mesh into the three linked particle sets
-// of the coupling method (METHOD.md, "Particles"): IBPs on the inner lattice, SBPs on the surface
+// of the coupling method (docs/method.md, "Particles"): IBPs on the inner lattice, SBPs on the surface
 // and GPs at the mesh vertices. Host only, double precision; convert to Real when uploading.
 #pragma once
 #include <cstdint>

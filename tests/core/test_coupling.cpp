@@ -4,7 +4,7 @@
 //   cube's IBPs together keep their momentum (the pair forces cancel; LSM keeps momentum), and the
 //   cube takes a good share of it. Without two-way coupling the same throw loses momentum: the
 //   cube pushes the fluid back and feels nothing.
-// - Floating (METHOD.md's validation data: the submerged fraction equals ρ_solid / ρ_fluid): a
+// - Floating (docs/method.md's validation data: the submerged fraction equals ρ_solid / ρ_fluid): a
 //   flat rigid box (0.3 × 0.12 × 0.3 m, stable upright) in a pool at rest, at two densities.
 #include <doctest/doctest.h>
 

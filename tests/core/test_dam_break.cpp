@@ -1,6 +1,6 @@
 // Dam break against Martin & Moyce (1952), n² = 2: a column a wide and 2a high collapses on a dry
 // floor. Two of their measurements on the same column (a = 2¼ in, their Tables 2 and 6;
-// METHOD.md gives the front's; the heights as transcribed in TormodLandet/Ocellaris,
+// docs/method.md gives the front's; the heights as transcribed in TormodLandet/Ocellaris,
 // scripts/plot_dam_break.py, beside the same front table), compared with one run at r0 = a/20,
 // free-slip walls, no tuning:
 //  - the residual height of the column, H/(2a) against τ = t sqrt(g/a): the bulk of the collapse.

@@ -1,4 +1,4 @@
-// Heat conduction (algorithms/heat.hpp) in the full solver, against METHOD.md's analytic case:
+// Heat conduction (algorithms/heat.hpp) in the full solver, against docs/method.md's analytic case:
 // two half-spaces at T1 and T2 brought into contact at t = 0 follow
 //   T(x, t) = (T1 + T2)/2 + (T2 - T1)/2 erf((x - x0) / (2 sqrt(α t))).
 //
@@ -15,7 +15,7 @@
 //   2                  9                       0.999   0.03%   0.116 / 23.5%
 //
 // The heat content moved by at most 6.2e-7 (relative) from the first step to the last, and every
-// temperature stayed within [T1, T2]. Backward Euler by Jacobi sweeps (METHOD.md's scheme, built
+// temperature stayed within [T1, T2]. Backward Euler by Jacobi sweeps (docs/method.md's scheme, built
 // first) needed 4 sweeps at 0.2 and 28 at 2 and was still 4-11% slow (docs/heat.md).
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-// A column of water at rest (METHOD.md: p(y) = ρ0 g (H - y)).
+// A column of water at rest (docs/method.md: p(y) = ρ0 g (H - y)).
 //
 // What is asserted, and why: PCISPH's per-particle pressure is δ times the step's accumulated
 // density correction, so besides the hydrostatic part it carries a particle-to-particle scatter

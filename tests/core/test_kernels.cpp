@@ -1,4 +1,4 @@
-// Kernel normalisation, gradient antisymmetry, and PCISPH's δ against METHOD.md's check values;
+// Kernel normalisation, gradient antisymmetry, and PCISPH's δ against docs/method.md's check values;
 // the viscosity operator (Eq. 4, and Eq. 8 against walls) on a lattice against its expected values.
 #include <doctest/doctest.h>
 
@@ -87,7 +87,7 @@ TEST_CASE_TEMPLATE("the branch-free forms of W, grad W and the viscosity Laplaci
     CHECK(norm(kernel.grad_W_r2(Vec3{0, 0, 0}, 0)) == 0);  // a particle and itself: no force
 }
 
-TEST_CASE("PCISPH delta matches the check values of METHOD.md") {
+TEST_CASE("PCISPH delta matches the check values of docs/method.md") {
     const double r0 = 0.02, dt = 0.003, rho0 = 1000;
     {
         const CubicSpline3D kernel = CubicSpline3D::with_support(Real(2 * r0));
