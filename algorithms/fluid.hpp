@@ -21,7 +21,9 @@ class Fluid final : public Module {
         if (!state.has_fluid) return;
         const FluidParams& fp = state.params.fluid;
         const std::size_t moving = state.store.moving_count();
-        has_viscosity_ = fp.viscosity > 0 || (fp.wall_viscosity > 0 && state.store.static_count() > 0);
+        // Friction (Eq. 8) acts against every boundary particle, static or of a moving solid.
+        const bool boundary = state.store.static_count() > 0 || volumes.moving_solids();
+        has_viscosity_ = fp.viscosity > 0 || (fp.wall_viscosity > 0 && boundary);
         pressure_acc_.resize(moving);
         pressure_term_.resize(moving);
         predicted_.resize(moving);

@@ -1,5 +1,5 @@
-// Interface tension between fluid and moving solids (the paper's Eq. 9, after [IUD10]; docs/method.md
-// step 3): a fluid particle i within h of a surface particle s (SBP) of an object whose
+// Interface tension between fluid and moving solids (the paper's Eq. 9, after [IUD10]; docs/method.md,
+// "Non-pressure forces"): a fluid particle i within h of a surface particle s (SBP) of an object whose
 // `interface_tension` η_s is not 0 is drawn toward it,
 //
 //   F_{i<-s} = -η_s m_i ψ_s W(x_is, h) x_is / |x_is|,   ψ_s = ρ0 V_s,  x_is = x_i - x_s,

@@ -1,6 +1,6 @@
 // The time step, stage by stage, in the order of the method (docs/method.md, "One time step").
 // Host-only and backend-free: `meltwater info`, the stats.csv columns and the docs' stage table
-// (docs/stages.md, checked by tests/cli) are read from this table. A module binds its functions
+// (docs/architecture.md, checked by tests/cli) are read from this table. A module binds its functions
 // to these names (algorithms/module.hpp); a scene runs the stages some module bound, in this order.
 #pragma once
 #include <cstddef>

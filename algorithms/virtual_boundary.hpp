@@ -29,8 +29,8 @@
 //
 // The correction acts only within the band c = kMovingSolidContact r0 of that surface: fluid at
 // rest lies 0.65-0.8 r0 from an object's SBPs (0.81 r0 under a floating box, docs/coupling.md),
-// which a band of r0 would hold on its edge, as it did at the walls before their band was
-// narrowed (wall_contact.hpp). The test radius stays r0, so that fluid up to r0 inside the
+// which a band of r0 would hold on its edge, as it would at the walls with a band of r0
+// (wall_contact.hpp). The test radius stays r0, so that fluid up to r0 inside the
 // surface is still found and put back.
 #pragma once
 #include <cmath>

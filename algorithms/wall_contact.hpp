@@ -25,8 +25,8 @@
 // start r0/2 inside the faces), so the band is r0 for one layer and 0.875 r0 for two. Static
 // boxes: their first layer lies on their faces, so the rest distance is the same for the same
 // layers, and the band is also kept inside the distance at which the scene builder's carve can
-// leave fluid (carved_face_distance(), sampling/fluid_clearance.hpp; apps/scene_builder.cpp
-// sets each box's band). Near a box's edges and corners the band is rounded (the
+// leave fluid (carved_face_distance(), sampling/fluid_clearance.hpp; contact_box() below sets each
+// box's band from what the scene builder passes). Near a box's edges and corners the band is rounded (the
 // distance to the box, not to its faces' planes), so fluid flowing round an edge is not pushed
 // off it. Static mesh objects: the same rule on their signed distance, with the normal its
 // gradient (so rounded at edges and corners as well); a particle found inside leaves through the
@@ -35,7 +35,7 @@
 // inner lattice behind them) than to a wall's layer. Measured (h = 2 r0, cubic spline, a box
 // object in pools 0.4 and 0.9 m deep): 0.65-0.75 r0 from its faces, down to 0.54 r0 by its edges;
 // the band stays 0.1 r0 short of that, and the 0.4 m pool settles bitwise the same with it as
-// without it (docs/solver.md, "Static mesh objects").
+// without it (docs/solver.md, "The walls' velocity–position correction").
 #pragma once
 #include <limits>
 
@@ -114,10 +114,10 @@ struct WallContact {
     // removed. Objects and boxes first, the walls last: a particle pushed out of a box that stands
     // on the floor must not end up beyond the floor's layer. Non-finite values are left to the
     // guard.
-    // Always inlined, with the shapes' loops in a function apart: once the objects' loop was
-    // added, g++ reordered the walls' tests and then called this out of line (callgrind, 10 steps
-    // of the default dam break, 1 thread: 160M instructions in the predictions, the integration
-    // and the calls; 119M as written now, against 111M before static objects were covered).
+    // Always inlined, with the shapes' loops in a function apart: with the objects' loop inline,
+    // g++ reorders the walls' tests and then calls this out of line (callgrind, 10 steps of the
+    // default dam break, 1 thread: 160M instructions in the predictions, the integration and the
+    // calls; 119M as written, against 111M with no loop over shapes at all).
     MW_ALWAYS_INLINE void correct(Vec3& x, Vec3& v) const {
         if (objects.size() + boxes.size() != 0) correct_shapes(x, v);
         axis(x.x, v.x, lo.x, hi.x);

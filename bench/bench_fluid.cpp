@@ -599,7 +599,8 @@ int main(int argc, char** argv) {
                     const std::vector<std::string> names = sim.stage_names();
                     const StepReport& rep = sim.last_report();
                     step_ms.push_back(rep.total_ms);
-                    if (rep.value("heat_substeps") > 0) substeps.push_back(int(rep.value("heat_substeps")));
+                    if (rep.has("heat_substeps") && rep.value("heat_substeps") > 0)
+                        substeps.push_back(int(rep.value("heat_substeps")));
                     for (std::size_t k = 0; k < names.size() && k < rep.stage_ms.size(); ++k) {
                         if (names[k] == "heat") heat_ms.push_back(rep.stage_ms[k]);
                         if (names[k] == "pcisph") pcisph_ms.push_back(rep.stage_ms[k]);
@@ -649,8 +650,9 @@ int main(int argc, char** argv) {
                     const std::vector<std::string> names = sim.stage_names();
                     const StepReport& rep = sim.last_report();
                     step_ms.push_back(rep.total_ms);
-                    const bool melted_now = long(rep.value("melted")) > melted;
-                    melted = long(rep.value("melted"));
+                    const long melted_total = rep.has("melted") ? long(rep.value("melted")) : 0;
+                    const bool melted_now = melted_total > melted;
+                    melted = melted_total;
                     for (std::size_t k = 0; k < names.size() && k < rep.stage_ms.size(); ++k) {
                         if (names[k] == "melting") (melted_now ? melt_step_ms : quiet_ms).push_back(rep.stage_ms[k]);
                         if (names[k] == "lsm") lsm_ms.push_back(rep.stage_ms[k]);

@@ -16,7 +16,7 @@ namespace mw {
 // Fluid particles closer than this many r0 to a particle of a static box or an object are left
 // out. A fluid layer r0/2 from an Akinci layer starts 55% over-dense and PCISPH blows it apart in
 // the first step; at r0 it is 6% over-dense, which the first step corrects quietly
-// (docs/solver.md, "Where the walls go").
+// (docs/solver.md, "Boundaries").
 constexpr double kFluidClearance = 1.0;
 
 // The closest a fluid particle kept by that rule can start to a static box's face, whose first

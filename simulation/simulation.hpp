@@ -139,6 +139,11 @@ struct StepReport {
     std::vector<double> stage_ms;  // per stage, same order as stage_names()
     double total_ms = 0;
 
+    bool has(const std::string& name) const {
+        for (const std::string& c : column_names)
+            if (c == name) return true;
+        return false;
+    }
     // The value of column `name`; throws std::out_of_range when the scene has no such column.
     double value(const std::string& name) const {
         for (std::size_t k = 0; k < column_names.size() && k < columns.size(); ++k)

@@ -1,8 +1,8 @@
 // A block of water dropped flat onto the floor of a tank it fills sideways: the whole column must
 // stop within a step or two, which the CFL bound (0.4 r0 / v) does not see. At Δt = 2 ms the
-// PCISPH iteration diverged in the impact step and threw most of the fluid out of the tank
-// (docs/solver.md, "Flat impacts"). In CFL mode a diverging step is now taken again at half the
-// step; with eta_max bounding the peak error as well, the impact then loses energy, as it must.
+// PCISPH iteration diverges in the impact step and throws most of the fluid out of the tank
+// (docs/solver.md, "Time step"). In CFL mode a diverging step is taken again at half the step;
+// with eta_max bounding the peak error as well, the impact then loses energy, as it must.
 // Checked at 2% and at the scenes' default bound, 5 eta = 5% (simulation.hpp, default_eta_max).
 #include <doctest/doctest.h>
 

@@ -69,7 +69,7 @@ TEST_CASE("a water column on a pinned elastic slab settles as on a floor: hydros
     // still sloshed, and the worst layer measured 1.2-2.2% over small changes of the set-up (μ ±
     // 0.2%, the walls' mirror images on or off, double precision); now 0.87-1.54% over ten.
     // dt = 1 ms because the carved layer leaves a 0.4 r0 drop, and PCISPH does not survive the
-    // flat impact of the whole column at dt = 2 ms (docs/solver.md, "Flat impacts").
+    // flat impact of the whole column at dt = 2 ms (docs/solver.md, "Time step").
     const int steps = 1000, averaged = 200;
     double lowest_fluid = 1e9;
     // Every 5th step is enough to see a leak: a leaked particle stays below.

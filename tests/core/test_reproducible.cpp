@@ -296,7 +296,7 @@ TEST_CASE("CFL time steps follow the last step's largest speed and gravity, capp
 TEST_CASE("CFL retries: the largest step grows back by at most a quarter, by less when retries come close together") {
     // The resting column of scenes/hydrostatic_column.json (2,000 particles, 20 layers) with a
     // largest step of 0.01 s, far above the ~4 ms its PCISPH holds: steps keep diverging and are
-    // retried at half the step (docs/solver.md, "A column at rest far beyond its step").
+    // retried at half the step (docs/solver.md, "Time step").
     SimulationSetup setup =
         test::fluid_in_box({0, 0, 0}, {0.2f, 0.6f, 0.2f}, {0, 0, 0}, {0.2f, 0.4f, 0.2f}, 0.02f, 0.01f);
     setup.params.gravity = {0, -9.81f, 0};

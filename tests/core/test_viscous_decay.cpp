@@ -12,7 +12,7 @@
 // walls that matters where cos² is largest; near the side walls (z), where the mode does not vary,
 // the missing neighbours would have carried its y variation. The sum also runs over the fluid's
 // mirror images across the domain's free-slip walls (algorithms/wall_mirror.hpp). Decay rate
-// against ν (π/H)², measured with a probe of this set-up (the development VM, 2-core Intel Xeon,
+// against ν (π/H)², measured with a probe of this set-up (the 2-core development VM,
 // OpenMP, float; H = 0.2 m, L = 1 m, μ = 4 Pa s; amplitude
 // over the middle fifth against the initial A, 0.5 s), by the depth D between the side walls:
 //
