@@ -174,7 +174,7 @@ inline void lsm_region_update(const DeviceContext& device, const LsmData d) {
         const Quat R = polar_rotation(A, d.rotation[r]);
         d.rotation[r] = R;
         // Converted once per region here rather than once per (IBP, region) pair in the goals,
-        // where it was the largest cost of an elastic step (about 125 pairs per IBP at w = 2).
+        // where it would be the largest cost of an elastic step (about 125 pairs per IBP at w = 2).
         d.rotation_matrix[r] = quat_to_mat3(R);
         const Vec3 ubar = ua + S.su / M;
         d.mean_displacement[r] = ubar;

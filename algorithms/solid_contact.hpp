@@ -33,7 +33,7 @@
 // step (grid.for_each_*_around_particle), not around where they are now: the pairs visited are
 // then the same from either side however far they moved, so the impulses the SBPs gather add up
 // to what the fluid gave. (Searched around their current positions, a throw at 8 m/s and
-// Δt = 4 ms lost 5.3e-3 of its momentum; now 3e-7.) A pair is visited for certain while the two
+// Δt = 4 ms loses 5.3e-3 of its momentum; as written, 3e-7.) A pair is visited for certain while the two
 // moved less than h - r0 together in the step (r0 at h = 2 r0); a pair missed is missed by both.
 #pragma once
 #include <cstdint>

@@ -166,7 +166,7 @@ TEST_CASE("bad input: one line naming the problem, exit code 2") {
     std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("meshes of any size: the ray tracer's float range no longer hangs or exhausts memory") {
+TEST_CASE("meshes of any size: the ray tracer's float range neither hangs nor exhausts memory") {
     const auto dir = temp_dir("scale");
     std::ofstream(dir / "tet.obj") << mwtest::kTetVertices << mwtest::kTetFaces;
     const struct {
