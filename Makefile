@@ -1,11 +1,11 @@
-# Three entry points; each runs the idempotent set-up first (missing Debian packages, CMake
-# configure in Release), then builds only what it needs.
+# The entry points; each runs the idempotent set-up first (missing Debian packages, CMake
+# configure in Release, or the sanitizer build in build-sanitize/), then builds only what it needs.
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 OUT ?= results/demo
 export BUILD_DIR
 
-.PHONY: setup build demo test bench clean
+.PHONY: setup build demo test bench sanitize fuzz ci ci-short clean
 
 setup:
 	@./scripts/setup.sh
@@ -23,5 +23,23 @@ test: build
 bench: build
 	@./bench/run_benchmarks.sh $(BUILD_DIR)
 
+# Every test under AddressSanitizer and UndefinedBehaviorSanitizer (clang, no CUDA), or the ctest
+# selection given: make sanitize TESTS="-L '^cli$$'".
+sanitize:
+	@./scripts/sanitize.sh $(TESTS)
+
+# Each fuzz target for FUZZ_SECONDS (default 300): make fuzz FUZZ_SECONDS=60.
+fuzz:
+	@./scripts/fuzz.sh
+
+# What CI runs (.ci/run): every test (make test), then make ci-short: the short form of the
+# sanitizer run (the command line's and the sampler's tests and the fuzz replays, less the long
+# same-results comparisons, building only their programs) and of the fuzzing (a minute a target).
+SANITIZE_CI_TARGETS = meltwater test_cli test_sampling test_sampling_cli fuzz_scene_reader fuzz_obj_reader fuzz_checkpoint_reader
+ci: test ci-short
+ci-short:
+	@SANITIZE_TARGETS="$(SANITIZE_CI_TARGETS)" ./scripts/sanitize.sh -L '^(cli|sampling|sampling_cli|fuzz)$$' -E '^same results'
+	@FUZZ_SECONDS=60 ./scripts/fuzz.sh
+
 clean:
-	@rm -rf $(BUILD_DIR)
+	@rm -rf $(BUILD_DIR) build-sanitize

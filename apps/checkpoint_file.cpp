@@ -1,5 +1,6 @@
 #include "apps/checkpoint_file.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -8,6 +9,7 @@
 #include <ostream>
 
 #include "apps/atomic_file.hpp"
+#include "apps/cli_common.hpp"
 #include "backend/config.hpp"
 #include "common/errors.hpp"
 
@@ -72,6 +74,33 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
     });
 }
 
+namespace {
+// The header's step and time are what a resumed run reports and numbers its frames from; the
+// state's are what it continues. The checksum only says the file is as written, so a file made
+// or edited with a valid checksum is still checked for the two agreeing, and for a frame clock
+// that runs forward and not past the state's time.
+void check_clock(const Checkpoint& c, const std::string& where) {
+    const long state_step = c.state.get_value<long>("step");
+    const double state_time = c.state.get_value<double>("time");
+    if (state_step != c.step || state_time != c.time)
+        throw InputError(where + " is inconsistent: its header says step " + std::to_string(c.step) + ", t = " +
+                         format_number(c.time) + " s, its state step " + std::to_string(state_step) + ", t = " +
+                         format_number(state_time) + " s");
+    double previous = 0;
+    for (std::size_t k = 0; k < c.frame_times.size(); ++k) {
+        const double t = c.frame_times[k];
+        if (!(t >= previous && t <= c.time))
+            throw InputError(where + " is inconsistent: frame " + std::to_string(k) + " is at t = " + format_number(t) +
+                             " s, " + (t > c.time ? "after the state's t = " + format_number(c.time) + " s"
+                                                  : "before the frame ahead of it"));
+        previous = t;
+    }
+    if (!(c.next_frame_time >= previous && std::isfinite(c.next_frame_time)))
+        throw InputError(where + " is inconsistent: its next frame is due at t = " + format_number(c.next_frame_time) +
+                         " s, before its last frame at t = " + format_number(previous) + " s");
+}
+}  // namespace
+
 Checkpoint read_checkpoint(const std::string& path) {
     const std::string where = "checkpoint '" + path + "'";
     std::error_code error;
@@ -81,7 +110,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     if (!in) throw InputError("cannot read " + where);
     const std::vector<unsigned char> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) throw InputError("failed while reading " + where);
+    return parse_checkpoint(file, where);
+}
 
+Checkpoint parse_checkpoint(const std::vector<unsigned char>& file, const std::string& where) {
     // The first line: magic and version.
     const std::size_t magic_length = std::strlen(kMagic);
     std::size_t line_end = 0;
@@ -152,6 +184,7 @@ Checkpoint read_checkpoint(const std::string& path) {
         at += n;
         c.state.add(std::move(b));
     }
+    check_clock(c, where);
     return c;
 }
 

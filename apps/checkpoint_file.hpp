@@ -33,5 +33,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& checkpoint);
 // Throws InputError naming the file and the problem (missing, not a checkpoint, another format
 // version, truncated, damaged).
 Checkpoint read_checkpoint(const std::string& path);
+// The same from the file's bytes; `where` names it in messages ("checkpoint 'PATH'").
+Checkpoint parse_checkpoint(const std::vector<unsigned char>& file, const std::string& where);
 
 }  // namespace mw

@@ -209,6 +209,7 @@ class Run {
     double frame_dt_ = 0, next_frame_time_ = 0;
     long checkpoint_step_ = -1;
     std::chrono::steady_clock::time_point wall_start_;
+    DiskSyncTotals synced_at_start_;
     std::exception_ptr failure_;
     bool interrupted_ = false;
 };
@@ -291,7 +292,14 @@ void Run::open_outputs() {
     // starts them afresh, its frames numbered on from the checkpoint's.
     continues_directory_ = resume_ && same_directory(out_dir_, checkpoint_dir_);
     frame_index_ = resume_ ? static_cast<int>(resume_->frame_times.size()) : 0;
-    remove_earlier_frames(out_dir_, continues_directory_ ? frame_index_ : 0);
+    const RemovedOutputs removed = remove_earlier_outputs(out_dir_, continues_directory_ ? frame_index_ : 0,
+                                                          continues_directory_);
+    if (!o_.quiet && !continues_directory_ && (removed.frames > 0 || !removed.records.empty())) {
+        std::string what = removed.frames > 0 ? count_of(removed.frames, "frame") : "";
+        for (const std::string& name : removed.records) what += (what.empty() ? "" : ", ") + name;
+        std::fprintf(stderr, "meltwater: note: removed an earlier run's outputs from %s (%s)\n", out_dir_.c_str(),
+                     what.c_str());
+    }
     if (resume_) frame_times_ = resume_->frame_times;
     if (scene_.writes_frames()) {
         frames_ = std::make_unique<FrameWriter>(out_dir_, scene_.writes_vtu());
@@ -299,7 +307,14 @@ void Run::open_outputs() {
         if (continues_directory_) frames_->keep_earlier(frame_times_);
     }
     stats_ = std::make_unique<StatsTable>(sim_->stage_names(), sim_->last_report().column_names);
-    if (continues_directory_) stats_->keep_earlier_rows(stats_rows_up_to(stats_path_, stats_->header(), resume_->step));
+    std::string stats_warning;
+    if (continues_directory_) {
+        const EarlierStatsRows earlier = stats_rows_up_to(stats_path_, stats_->header(), resume_->step);
+        stats_->keep_earlier_rows(earlier.rows);
+        if (!earlier.problem.empty())
+            stats_warning = earlier.problem + ": the resumed run's stats.csv starts after the checkpoint, at step " +
+                            std::to_string(resume_->step + 1);
+    }
     summary_.backend = sim_->backend_name();
     summary_.device = sim_->device_name();
     summary_.threads = o_.threads;
@@ -319,7 +334,7 @@ void Run::open_outputs() {
     }
     const std::string heat_warning = heat_substeps_warning(sim_->heat_substeps_needed(double(scene_.params.solver.dt)),
                                                            scene_.params.heat.max_substeps);
-    for (const std::string& warning : {scene_.kernel_warning(), heat_warning, emitter_warning_}) {
+    for (const std::string& warning : {scene_.kernel_warning(), heat_warning, emitter_warning_, stats_warning}) {
         if (warning.empty()) continue;
         std::fprintf(stderr, "meltwater: warning: %s\n", warning.c_str());
         summary_.warnings.push_back(warning);
@@ -366,7 +381,10 @@ void Run::write_frame() {
 }
 
 // The checkpoint: the state now, with the scene and the frame clock (checkpoint_file.hpp).
+// stats.csv goes to disk first: a run killed at any moment then leaves a stats.csv that reaches
+// at least its last checkpoint's step, which a resume continues from.
 void Run::write_checkpoint_now() {
+    stats_->write(stats_path_);
     Checkpoint c;
     c.scene = scene_.resolved;
     c.backend = summary_.backend;
@@ -462,6 +480,9 @@ bool Run::record_end() {
         }
     }
     summary_.wall_seconds = seconds_since(wall_start_);
+    const DiskSyncTotals synced = disk_sync_totals();
+    summary_.synced_files = synced.files - synced_at_start_.files;
+    summary_.sync_seconds = synced.seconds - synced_at_start_.seconds;
     summary_.frames = frames_ ? frames_->written() : 0;
     if (failure_) {
         summary_.status = "failed";
@@ -539,6 +560,7 @@ int Run::execute() {
     open_outputs();
     print_start();
     wall_start_ = std::chrono::steady_clock::now();
+    synced_at_start_ = disk_sync_totals();
     try {
         step_loop();
     } catch (...) {

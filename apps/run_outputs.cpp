@@ -8,8 +8,10 @@
 #include <filesystem>
 #include <fstream>
 #include <ostream>
+#include <set>
 
 #include "apps/atomic_file.hpp"
+#include "apps/checkpoint_file.hpp"
 #include "apps/vtu_writer.hpp"
 #include "common/errors.hpp"
 
@@ -65,7 +67,9 @@ int frame_number(const std::string& name, const std::string& extension) {
 }
 }  // namespace
 
-void remove_earlier_frames(const std::string& out_dir, int keep_below) {
+RemovedOutputs remove_earlier_outputs(const std::string& out_dir, int keep_frames_below, bool keep_records) {
+    RemovedOutputs removed;
+    std::set<int> frame_numbers;
     const std::string frames_dir = out_dir + "/frames";
     std::error_code error;
     if (std::filesystem::is_directory(frames_dir, error)) {
@@ -79,18 +83,26 @@ void remove_earlier_frames(const std::string& out_dir, int keep_below) {
                                ((frame_name.rfind("object_", 0) == 0 || frame_name.rfind("surface_", 0) == 0) &&
                                 extension == ".obj");
             const int number = frame ? frame_number(frame_name, extension) : -1;
-            const bool kept = tmp == std::string::npos && number >= 0 && number < keep_below;
+            const bool kept = tmp == std::string::npos && number >= 0 && number < keep_frames_below;
             if ((frame && !kept) || frame_name == "particles.pvd") std::filesystem::remove(entry.path(), error);
+            if (frame && !kept && tmp == std::string::npos && number >= 0) frame_numbers.insert(number);
         }
         std::filesystem::remove(frames_dir, error);  // only if now empty: a user's own files stay
     }
-    // The same for temporaries of stats.csv and summary.json in DIR itself.
+    removed.frames = static_cast<int>(frame_numbers.size());
+    // The temporaries of stats.csv, summary.json and the checkpoint in DIR itself, and the records.
     for (const auto& entry : std::filesystem::directory_iterator(out_dir, error)) {
         const std::string name = entry.path().filename().string();
         if (name.rfind("stats.csv.tmp.", 0) == 0 || name.rfind("summary.json.tmp.", 0) == 0 ||
-            name.rfind("checkpoint.mwc.tmp.", 0) == 0)
+            name.rfind(std::string(kCheckpointFileName) + ".tmp.", 0) == 0)
             std::filesystem::remove(entry.path(), error);
     }
+    if (!keep_records)
+        for (const std::string name : {"summary.json", "stats.csv", kCheckpointFileName})
+            if (std::filesystem::is_regular_file(out_dir + "/" + name, error) &&
+                std::filesystem::remove(out_dir + "/" + name, error))
+                removed.records.push_back(name);
+    return removed;
 }
 
 FrameWriter::FrameWriter(const std::string& out_dir, bool particles)
@@ -259,18 +271,30 @@ void StatsTable::write(const std::string& path) const {
     write_file_atomically(path, [&](std::ostream& out) { out << header() << '\n' << earlier_rows_ << csv_rows_; });
 }
 
-std::string stats_rows_up_to(const std::string& path, const std::string& header, long last_step) {
+EarlierStatsRows stats_rows_up_to(const std::string& path, const std::string& header, long last_step) {
+    if (last_step <= 0) return {};
     std::ifstream in(path);
-    std::string line, rows;
-    if (!in || !std::getline(in, line) || line != header) return "";
-    while (std::getline(in, line)) {
-        // A row starts with its step; a damaged line ends the table there.
+    std::string line;
+    if (!in) return {"", path + " is missing"};
+    if (!std::getline(in, line) || line != header) return {"", path + " has other columns than this run writes"};
+    std::string rows;
+    long previous = -1;
+    for (long number = 2; previous < last_step && std::getline(in, line); ++number) {
         char* end = nullptr;
         const long step = std::strtol(line.c_str(), &end, 10);
-        if (end == line.c_str() || *end != ',' || step > last_step) break;
+        if (end == line.c_str() || *end != ',')
+            return {"", path + " has a damaged row (line " + std::to_string(number) + ")"};
+        if (step > last_step) break;
+        if (previous >= 0 && step != previous + 1)
+            return {"", path + " jumps from step " + std::to_string(previous) + " to step " + std::to_string(step)};
         rows += line + '\n';
+        previous = step;
     }
-    return rows;
+    if (previous != last_step)
+        return {"", path + (previous < 0 ? std::string(" holds no rows up to") : " ends at step " + std::to_string(previous) +
+                                                                                 ", before") +
+                        " the checkpoint's step " + std::to_string(last_step)};
+    return {rows, ""};
 }
 
 std::vector<double> StatsTable::median_stage_ms() const {
@@ -369,6 +393,9 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     j["bytes_per_particle"] =
         run.particles.total() > 0 ? double(run.device_bytes) / double(run.particles.total()) : 0.0;
     j["frames"] = run.frames;
+    j["disk_sync"] = {{"files", run.synced_files},
+                      {"seconds", run.sync_seconds},
+                      {"fraction_of_wall", run.wall_seconds > 0 ? run.sync_seconds / run.wall_seconds : 0.0}};
     j["warnings"] = run.warnings;
     if (!run.resumed_from.empty())
         j["resumed_from"] = {{"checkpoint", run.resumed_from}, {"step", run.resumed_step},

@@ -19,13 +19,24 @@ namespace mw {
 // summary that says it wrote none: remove them (particles_*.vtu, particles.pvd, object_*.obj, surface_*.obj,
 // and the temporaries of a killed run), and frames/ itself when that leaves it empty. Run before
 // every run, with or without frames. A run resumed in its checkpoint's directory keeps the
-// frames numbered below `keep_below` (those written before the checkpoint).
-void remove_earlier_frames(const std::string& out_dir, int keep_below = 0);
+// frames numbered below `keep_frames_below` (those written before the checkpoint) and the earlier
+// run's records; any other run removes those too (stats.csv, summary.json, checkpoint.mwc), so
+// that a run killed early never leaves an earlier run's "completed" summary beside its frames.
+struct RemovedOutputs {
+    int frames = 0;                    // frame numbers of which a file was removed
+    std::vector<std::string> records;  // the records removed, by name
+};
+RemovedOutputs remove_earlier_outputs(const std::string& out_dir, int keep_frames_below, bool keep_records);
 
-// The rows of an earlier stats.csv at `path` up to and including step `last_step`, when its
-// header is `header` ("" otherwise: no file, or another set of columns). A run resumed in its
-// checkpoint's directory continues the table from there.
-std::string stats_rows_up_to(const std::string& path, const std::string& header, long last_step);
+// The rows of an earlier stats.csv at `path` up to and including step `last_step`. A run resumed
+// in its checkpoint's directory continues the table from there, so the rows must run one step
+// after another up to `last_step` exactly, under `header`; when they do not (no file, other
+// columns, a missing or damaged row), `rows` is empty and `problem` says why.
+struct EarlierStatsRows {
+    std::string rows;
+    std::string problem;
+};
+EarlierStatsRows stats_rows_up_to(const std::string& path, const std::string& header, long last_step);
 
 // Writes frames/particles_NNNNN.vtu (and the objects' meshes, once set_objects() was called),
 // and the fluid's surface meshes (write_surface).
@@ -141,6 +152,10 @@ struct RunSummary {
     // The last checkpoint this run wrote ("" if none), and its step.
     std::string checkpoint;
     long checkpoint_step = 0;
+    // Outputs flushed to disk (frames, stats.csv, checkpoints; apps/atomic_file.hpp), and the
+    // seconds their fsyncs and renames took.
+    long synced_files = 0;
+    double sync_seconds = 0;
 };
 
 double median_of(std::vector<double> values);  // 0 for none

@@ -149,9 +149,9 @@ const ParamTable<SceneObject>& object_keys() {
 std::vector<ParamDoc> keys_read_by_hand() {
     return {
         {"dimensions", "integer", "3", "3", "", "the scene's dimensions"},
-        {"objects[].name", "string", "\"object<i>\"", "letters, digits, _ and -; unique",
+        {"objects[].name", "string", "\"object<i>\"", "letters, digits, _ and -; unique", "",
          "names the object's output files"},
-        {"emitters[].name", "string", "\"emitter<i>\"", "letters, digits, _ and -; unique", "names it in info"},
+        {"emitters[].name", "string", "\"emitter<i>\"", "letters, digits, _ and -; unique", "", "names it in info"},
     };
 }
 

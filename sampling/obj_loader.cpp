@@ -1,6 +1,7 @@
 #include "sampling/obj_loader.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -27,7 +28,7 @@ TriangleMesh from_reader(const tinyobj::ObjReader& reader, const std::string& so
         const std::string err = first_line(reader.Error());
         throw InputError(source + ": cannot parse OBJ" + (err.empty() ? std::string() : " (" + err + ")"));
     }
-    // The reader drops invalid faces with only a warning; check_obj_text should have refused
+    // The reader drops invalid faces with only a warning; checked_obj_text should have refused
     // them already, and a face lost here would leave a hole, so any face warning is an error.
     std::istringstream warnings(reader.Warning());
     for (std::string warning; std::getline(warnings, warning);)
@@ -46,7 +47,7 @@ TriangleMesh from_reader(const tinyobj::ObjReader& reader, const std::string& so
         std::size_t offset = 0;
         for (std::size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
             const int n = shape.mesh.num_face_vertices[f];
-            // check_obj_text refuses faces with fewer than 3 corners; should one get here anyway
+            // checked_obj_text refuses faces with fewer than 3 corners; should one get here anyway
             // it is malformed input, never something to drop in silence.
             if (n < 3) {
                 std::ostringstream msg;
@@ -118,16 +119,24 @@ void for_each_vertex_and_face_line(const std::string& text, Visit&& visit) {
 
 // tinyobjloader is lenient where a sampler must not be: it reads "nan", "inf" and missing or
 // garbled coordinates as 0, drops faces with fewer than 3 corners or an index past the end with
-// only a warning, and parses indices with atoi (so 99999999999 wraps to another vertex). Vertex
-// and face lines are therefore checked here first, on the text, so each problem is reported with
-// its line number.
-void check_obj_text(const std::string& text, const std::string& source) {
+// only a warning, and parses indices with atoi (so 99999999999 wraps to another vertex). Its number
+// parser also overflows on exponents beyond ±2147483647 (and reads 1e-2147483649 as infinity),
+// and it converts skin weights ("vw") to int with no range check. Vertex and face lines are
+// therefore checked here first, on the text, so each problem is reported with its line number;
+// and the reader is given only what was checked, written afresh: each vertex as "v x y z" with the
+// values already read (printed so that they read back exactly), each face as "f" and its vertex
+// indices. Every other line (normals, texture coordinates, groups, materials, skin weights, ...)
+// the sampler does not use, and the reader never sees.
+std::string checked_obj_text(const std::string& text, const std::string& source) {
     // Faces may use vertices defined after them, so positive indices are checked against the
     // file's total, counted first.
     long long total_vertices = 0;
     for_each_vertex_and_face_line(text, [&](const ObjLine&, bool is_vertex) { total_vertices += is_vertex; });
     const double largest_parsed = double(std::numeric_limits<tinyobj::real_t>::max());
     long long vertices = 0, faces = 0;
+    std::string checked;
+    checked.reserve(text.size());
+    char number_text[64];
     for_each_vertex_and_face_line(text, [&](const ObjLine& line, bool is_vertex) {
         const std::vector<std::string> tokens = tokens_of(line.text, 2);
         if (is_vertex) {
@@ -138,12 +147,19 @@ void check_obj_text(const std::string& text, const std::string& source) {
                         << (tokens.size() == 1 ? "" : "s") << ", a vertex needs x y z";
                 reject_line(source, line, problem.str());
             }
+            checked += 'v';
             for (int k = 0; k < 3; ++k) {
                 const std::string& token = tokens[static_cast<std::size_t>(k)];
                 char* after = nullptr;
                 const double x = std::strtod(token.c_str(), &after);
                 const bool number = after != token.c_str() && *after == '\0';
-                if (number && std::isfinite(x) && std::abs(x) <= largest_parsed) continue;
+                if (number && std::isfinite(x) && std::abs(x) <= largest_parsed) {
+                    std::snprintf(number_text, sizeof number_text, " %.*g",
+                                  std::numeric_limits<tinyobj::real_t>::max_digits10,
+                                  double(static_cast<tinyobj::real_t>(x)));
+                    checked += number_text;
+                    continue;
+                }
                 std::ostringstream problem;
                 problem << "vertex " << vertices;
                 if (!number)
@@ -155,6 +171,7 @@ void check_obj_text(const std::string& text, const std::string& source) {
                             << ")";
                 reject_line(source, line, problem.str());
             }
+            checked += '\n';
             return;
         }
         ++faces;
@@ -164,6 +181,7 @@ void check_obj_text(const std::string& text, const std::string& source) {
                     << ", a face needs at least 3";
             reject_line(source, line, problem.str());
         }
+        checked += 'f';
         for (const std::string& corner : tokens) {
             // "v", "v/vt", "v//vn" or "v/vt/vn": the vertex index comes first.
             const std::string token = corner.substr(0, corner.find('/'));
@@ -172,7 +190,10 @@ void check_obj_text(const std::string& text, const std::string& source) {
             char* after = nullptr;
             const long long index = std::strtoll(token.c_str(), &after, 10);
             const bool number = !token.empty() && after != token.c_str() && *after == '\0';
-            if (number && index != 0 && index >= -vertices && index <= total_vertices) continue;
+            if (number && index != 0 && index >= -vertices && index <= total_vertices) {
+                checked += ' ' + std::to_string(index);
+                continue;
+            }
             std::ostringstream problem;
             problem << "face " << faces;
             if (!number)
@@ -186,7 +207,9 @@ void check_obj_text(const std::string& text, const std::string& source) {
                 problem << " refers to vertex " << token << ", but the file has " << total_vertices << " vertices";
             reject_line(source, line, problem.str());
         }
+        checked += '\n';
     });
+    return checked;
 }
 
 tinyobj::ObjReaderConfig config() {
@@ -211,9 +234,9 @@ TriangleMesh load_obj(const std::string& path, bool require_volume) {
 }
 
 TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume) {
-    check_obj_text(text, source);
+    const std::string checked = checked_obj_text(text, source);
     tinyobj::ObjReader reader;
-    reader.ParseFromString(text, std::string(), config());
+    reader.ParseFromString(checked, std::string(), config());
     return from_reader(reader, source, require_volume);
 }
 

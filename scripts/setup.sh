@@ -6,24 +6,12 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make ninja-build libeigen3-dev libnanoflann-dev libcxxopts-dev doctest-dev
           nlohmann-json3-dev libtinyobjloader-dev libembree-dev libtbb-dev python3-meshio
-          libopenvdb-dev libboost-dev libboost-iostreams-dev)
+          libopenvdb-dev libboost-dev libboost-iostreams-dev strace)
 # libboost-dev, libboost-iostreams-dev: OpenVDB's headers include Boost's and its CMake find module
-# asks for Boost.Iostreams, neither of which Debian 12's libopenvdb-dev pulls in.
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  if [[ $(id -u) -ne 0 ]]; then
-    echo "setup: missing Debian packages: ${missing[*]}" >&2
-    echo "setup: run as root, or: sudo apt-get install -y ${missing[*]}" >&2
-    exit 1
-  fi
-  echo "setup: installing ${missing[*]}"
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+# asks for Boost.Iostreams, neither of which Debian 12's libopenvdb-dev pulls in. strace: a test
+# watches the program flush its outputs to disk.
+./scripts/install_packages.sh "${packages[@]}"
+[[ "${1:-}" == "--packages-only" ]] && exit 0
 
 build_dir=${BUILD_DIR:-build}
 cuda=${MELTWATER_CUDA:-AUTO}

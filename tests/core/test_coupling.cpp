@@ -166,7 +166,10 @@ TEST_CASE("a rigid box floats: its draft follows Archimedes' law, less about one
     const Real r0 = 0.02f;
     const double box_y = 0.12;
     const Floating light = float_box(0.3, r0), heavy = float_box(0.7, r0);
-    for (const auto& [ratio, f] : {std::make_pair(0.3, light), std::make_pair(0.7, heavy)}) {
+    for (const auto& ratio_and_box : {std::make_pair(0.3, light), std::make_pair(0.7, heavy)}) {
+        // Named copies: CAPTURE's lambda cannot capture a structured binding under clang 14.
+        const double ratio = ratio_and_box.first;
+        const Floating& f = ratio_and_box.second;
         CAPTURE(ratio);
         const double expected = ratio * box_y;
         MESSAGE("density ratio " << ratio << ": draft " << f.draft << " m (Archimedes " << expected << " m, "

@@ -111,9 +111,12 @@ TEST_CASE("surface: the colour field is the fluid's kernel sum over the lattice'
 
 TEST_CASE("surface: a lattice block's mesh is closed, faces outward, and holds N r0³") {
     // 10 x 8 x 6 layers of particles, r0 apart; the default kernel, and the paper's h with Wendland C2.
-    for (const auto& [support, kernel] : {std::pair{Real(2), KernelKind::kCubicSpline},
-                                          std::pair{Real(2.5), KernelKind::kWendlandC2}})
+    for (const auto& support_and_kernel : {std::pair{Real(2), KernelKind::kCubicSpline},
+                                           std::pair{Real(2.5), KernelKind::kWendlandC2}})
     for (double voxel : {0.5, 0.25, 1.0}) {
+        // Named copies: CAPTURE's lambda cannot capture a structured binding under clang 14.
+        const Real support = support_and_kernel.first;
+        const KernelKind kernel = support_and_kernel.second;
         const SimulationSetup setup = block_at_rest(Vec3{0.1f, 0.1f, 0.1f}, Vec3{0.3f, 0.26f, 0.22f}, support, kernel);
         const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
         CAPTURE(std::string(kernel_name(kernel)));

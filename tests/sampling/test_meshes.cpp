@@ -156,6 +156,38 @@ TEST_CASE("malformed OBJ lines are named by their line, never misreported or dro
     CHECK(parse_obj(tet_faces + tet_vertices, "faces_first.obj").triangles.size() == 4);
 }
 
+TEST_CASE("OBJ numbers the reader would overflow on: exponents read as written, unused lines never read") {
+    const std::string& tet_vertices = mwtest::kTetVertices;
+    const std::string& tet_faces = mwtest::kTetFaces;
+    const TriangleMesh plain = parse_obj(tet_vertices + tet_faces, "plain.obj");
+    // Exponents beyond int: tinyobjloader's parser overflows on them (undefined behaviour, caught
+    // by `make sanitize`) and reads 1e-2147483649 as infinity. Both are 0 here, as strtod reads them.
+    const TriangleMesh tiny = parse_obj("v 0e2147483648 0 0\nv 1 0 0\nv 0 1 0\nv 1e-2147483649 0 1\n" + tet_faces, "e.obj");
+    CHECK(tiny.vertices[0].x() == 0.0);
+    CHECK(tiny.vertices[3].x() == 0.0);
+    CHECK(tiny.vertices[3].z() == 1.0);
+    // A coordinate written with a long exponent or many digits reads as the number it is.
+    const TriangleMesh long_form = parse_obj(
+        "v 0 0 0\nv 1000000000000000000000000000000000000000e-0000000000000000000000000039 0 0\nv 0 1.0e+0000 0\n"
+        "v 0 0 0.100000000000000000000000000000000000000000000000000001e1\n" + tet_faces, "long.obj");
+    for (std::size_t i = 0; i < plain.vertices.size(); ++i) CHECK(long_form.vertices[i] == plain.vertices[i]);
+    // Lines the sampler does not use are not read at all: skin weights (which the reader converts
+    // to int unchecked), vertex colours, normals and texture coordinates out of any range,
+    // smoothing groups, tags, lines and points.
+    const std::string unused =
+        "vw 0 3e9 1\nvw 1 -1e300 1e300\nvn 1e999999999999 0 0\nvt 0e2147483648 1\ns 99999999999\n"
+        "t crease 2/1/0 1 2\nl 1 99999999999\np 1\no name\ng a b\nusemtl none\nmtllib missing.mtl\n";
+    const TriangleMesh with_unused =
+        parse_obj(unused + "v 0 0 0 1e2147483648 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + tet_faces, "unused.obj");
+    REQUIRE(with_unused.vertices.size() == plain.vertices.size());
+    for (std::size_t i = 0; i < plain.vertices.size(); ++i) CHECK(with_unused.vertices[i] == plain.vertices[i]);
+    CHECK(with_unused.triangles == plain.triangles);
+    // Texture and normal indices in faces are not read either: only the vertex index counts.
+    const TriangleMesh corners =
+        parse_obj(tet_vertices + "f 1/99999999999/1 3/1/-99999999999 2//1\nf 1 2 4\nf 2 3 4\nf 3 1 4\n", "c.obj");
+    CHECK(corners.triangles == plain.triangles);
+}
+
 TEST_CASE("coordinates out of range or too far to resolve: one clear error, the mesh left as it was") {
     TriangleMesh box = make_box(Vec3d(1, 1, 1));
     box.source = "box";

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "tests/sampling/sampling_helpers.hpp"
+#include "tests/sanitizer.hpp"
 #include "tests/scratch_dir.hpp"
 #include "tests/skip.hpp"
 
@@ -40,7 +41,7 @@ Run run_sample(const std::string& args, const std::string& limits = "") {
     return r;
 }
 
-const std::string kGuard = "ulimit -v 4000000; timeout 30";
+const std::string kGuard = mw_test::memory_and_time_guard();
 
 std::string read_file(const std::filesystem::path& p) {
     std::ifstream in(p, std::ios::binary);
