@@ -185,8 +185,9 @@ inline void build_elastic_regions(const std::vector<std::array<int, 3>>& lattice
 }
 
 // Regularised inverse of a symmetric positive semi-definite matrix (in double): line-like
-// regions have no inertia about their axis, and no angular momentum about it either.
-inline SymMat3 regularised_inverse(double xx, double yy, double zz, double xy, double xz, double yz) {
+// regions have no inertia about their axis, and no angular momentum about it either. Also in
+// kernels (a rigid object at the walls, lsm.hpp).
+MW_INLINE SymMat3 regularised_inverse(double xx, double yy, double zz, double xy, double xz, double yz) {
     const double reg = 1e-4 * (xx + yy + zz) + 1e-300;
     xx += reg, yy += reg, zz += reg;
     const double c00 = yy * zz - yz * yz, c01 = xz * yz - xy * zz, c02 = xy * yz - xz * yy;

@@ -103,6 +103,8 @@ class SolidBodies final : public Module {
             region_omega_.assign(regions, Vec3{0, 0, 0});
         }
         objects_.upload(L.objects);
+        has_rigid_ = false;
+        for (const auto& o : L.objects) has_rigid_ = has_rigid_ || o.rigid;
         gp_rest_.upload(L.gp_rest);
         gp_offsets_.upload(L.gp_offsets);
         gp_links_.upload(L.gp_links);
@@ -259,6 +261,7 @@ class SolidBodies final : public Module {
         p.domain_min = domain_min;
         p.domain_max = domain_max;
         lsm_particle_update(device_, d, p);
+        if (has_rigid_) lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_);
         const InterpolationData g = interpolation(store);
         interpolate_geometry(device_, g, dt);
         interpolate_surface(device_, g);
@@ -517,6 +520,7 @@ class SolidBodies final : public Module {
     Vec3 gravity_{0, 0, 0}, domain_min_{0, 0, 0}, domain_max_{0, 0, 0};
     bool predicts_ = false;
     std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0, object_count_ = 0;
+    bool has_rigid_ = false;  // any rigid object (lsm_rigid_walls)
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;
     DeviceArray<Vec3> rest_;
