@@ -38,6 +38,12 @@ std::vector<std::string> floating_boxes_args(const std::string& out, long steps)
             out};
 }
 
+// The same scene as one command line for run(): `extra` options, then --out DIR.
+std::string floating_boxes_command(const std::string& extra, const std::string& out) {
+    return "run " + std::string(MW_SOURCE_DIR) +
+           "/scenes/floating_boxes.json --set fluid.spacing=0.04 --set fluid.support_radius=0.08 " + extra + " --out " + out;
+}
+
 // Starts `meltwater ARGS` in the background, its output discarded; returns its process id.
 pid_t start(const std::vector<std::string>& args) {
     const pid_t pid = ::fork();
@@ -118,10 +124,7 @@ TEST_CASE("durability: killed after a checkpoint, stats.csv reaches it, and the 
 
 TEST_CASE("durability: a resume whose stats.csv stops short of the checkpoint says so and starts the table after it") {
     const std::string dir = out_dir("durable_short_stats");
-    Result r = run("run " + std::string(MW_SOURCE_DIR) +
-                   "/scenes/floating_boxes.json --set fluid.spacing=0.04 --set fluid.support_radius=0.08 "
-                   "--steps 12 --checkpoint --threads 2 --quiet --out " +
-                   dir);
+    Result r = run(floating_boxes_command("--steps 12 --checkpoint --threads 2 --quiet", dir));
     REQUIRE(r.code == 0);
     // Rows 1 to 7 only, as a stats.csv from another time would hold.
     std::istringstream in(slurp(dir + "/stats.csv"));
@@ -137,10 +140,7 @@ TEST_CASE("durability: a resume whose stats.csv stops short of the checkpoint sa
     REQUIRE(warnings.size() == 1);
     CHECK(contains(warnings[0].get<std::string>(), "starts after the checkpoint, at step 13"));
     // A gap inside the rows is refused the same way.
-    r = run("run " + std::string(MW_SOURCE_DIR) +
-            "/scenes/floating_boxes.json --set fluid.spacing=0.04 --set fluid.support_radius=0.08 "
-            "--steps 12 --checkpoint --threads 2 --quiet --out " +
-            dir);
+    r = run(floating_boxes_command("--steps 12 --checkpoint --threads 2 --quiet", dir));
     REQUIRE(r.code == 0);
     std::istringstream rows(slurp(dir + "/stats.csv"));
     std::string gapped;
@@ -156,10 +156,7 @@ TEST_CASE("durability: a resume whose stats.csv stops short of the checkpoint sa
 
 TEST_CASE("durability: a fresh run in a reused directory removes the earlier run's records before its first frame") {
     const std::string dir = out_dir("durable_reused");
-    Result r = run("run " + std::string(MW_SOURCE_DIR) +
-                   "/scenes/floating_boxes.json --set fluid.spacing=0.04 --set fluid.support_radius=0.08 "
-                   "--steps 3 --checkpoint --threads 2 --quiet --out " +
-                   dir);
+    Result r = run(floating_boxes_command("--steps 3 --checkpoint --threads 2 --quiet", dir));
     REQUIRE(r.code == 0);
     REQUIRE(read_json(dir + "/summary.json")["status"] == "completed");
     // The new run is killed as soon as its own frame 0 is in place (the earlier one removed here,
@@ -170,10 +167,7 @@ TEST_CASE("durability: a fresh run in a reused directory removes the earlier run
     CHECK_FALSE(fs::exists(dir + "/summary.json"));
     CHECK_FALSE(fs::exists(dir + "/" + mw::kCheckpointFileName));
     // Run to its end, the fresh run says what it removed.
-    r = run("run " + std::string(MW_SOURCE_DIR) +
-            "/scenes/floating_boxes.json --set fluid.spacing=0.04 --set fluid.support_radius=0.08 "
-            "--steps 2 --threads 2 --out " +
-            dir);
+    r = run(floating_boxes_command("--steps 2 --threads 2", dir));
     CAPTURE(r.err);
     REQUIRE(r.code == 0);
     CHECK(contains(r.err, "removed an earlier run's outputs from"));
@@ -181,10 +175,7 @@ TEST_CASE("durability: a fresh run in a reused directory removes the earlier run
 
 TEST_CASE("durability: a checkpoint whose header disagrees with its state is refused, whatever its checksum") {
     const std::string dir = out_dir("durable_header");
-    const Result r = run("run " + std::string(MW_SOURCE_DIR) +
-                         "/scenes/floating_boxes.json --set fluid.spacing=0.04 --set fluid.support_radius=0.08 "
-                         "--set output.fps=200 --steps 12 --checkpoint --threads 2 --quiet --out " +
-                         dir);
+    const Result r = run(floating_boxes_command("--set output.fps=200 --steps 12 --checkpoint --threads 2 --quiet", dir));
     REQUIRE(r.code == 0);
     const mw::Checkpoint good = mw::read_checkpoint(dir + "/checkpoint.mwc");
     // Each edit written back through the writer, so its checksum is valid.

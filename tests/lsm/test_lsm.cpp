@@ -577,7 +577,7 @@ TEST_CASE("dropped on the floor: the lowest IBPs rest at domain_min.y + r0/2 wit
     }
 }
 
-TEST_CASE("a rigid object meets the walls whole: thrown at the ceiling and landing on an edge, it keeps its shape and comes to rest") {
+TEST_CASE("a rigid object meets the walls whole: thrown at the ceiling and dropped onto a corner, it keeps its shape and comes to rest") {
     // Every step the IBPs must sit on a rigid motion of their rest shape, none past a wall's margin
     // r0/2, and no energy may be gained. The bound on the least-squares fit's largest residual is
     // r0/10: the LSM update moves each IBP along its velocity, so a spinning body is stretched by
