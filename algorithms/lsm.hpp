@@ -288,23 +288,27 @@ inline void lsm_particle_update(const DeviceContext& device, const LsmData d, co
     });
 }
 
+// Sweeps over a rigid object's contacts with the walls (lsm_rigid_walls).
+constexpr int kRigidWallSweeps = 8;
+
 MW_INLINE Real component(Vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
 MW_INLINE Vec3 axis_vector(int axis, Real length) {
     return Vec3{axis == 0 ? length : Real(0), axis == 1 ? length : Real(0), axis == 2 ? length : Real(0)};
 }
 
 // A rigid object at the domain walls, as one body (after lsm_particle_update; one thread per
-// object, its IBPs in slot order: deterministic). A wall that any IBP has passed (past the margin
-// r0/2, as for elastic objects) is a contact at the mean of the IBPs past it. There, through the
-// body's mass and inertia, an inelastic impulse along the wall's normal takes the body's velocity
-// into the wall to zero, so a box landing on a corner turns down towards a face; and friction
-// takes a share `friction` of the body's sliding along the wall (as an elastic object's IBPs lose
-// theirs). Then the whole body moves out by each wall's deepest IBP, and every IBP takes the
-// body's velocity at its place: no IBP moves apart from the body's rigid motion.
+// object, its IBPs in slot order: deterministic). Every IBP past a wall (past the margin r0/2, as
+// for elastic objects) is a contact. Through the body's mass and inertia, inelastic impulses at
+// the contacts take the body's velocity into the walls there to zero, so a box landing on a
+// corner turns down onto a face and rests on all of it; friction takes a share `friction` of the
+// body's sliding along each wall touched (as an elastic object's IBPs lose theirs). Then the
+// whole body moves out by each wall's deepest IBP, and every IBP takes the body's velocity at its
+// place: no IBP moves apart from the body's rigid motion. `wall_impulse` (one per IBP) holds the
+// contacts' impulses while they are summed.
 // Clamped IBP by IBP, a rigid box thrown against the ceiling was squashed against it (the shape
 // matching of the next step fits the squashed shape, which the walls squash again).
 inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const LsmStepParams p,
-                            const std::uint32_t* object_ibp_begin, std::size_t object_count) {
+                            const std::uint32_t* object_ibp_begin, std::size_t object_count, Vec3* wall_impulse) {
     parallel_for(device, "lsm_rigid_walls", object_count, [=] MW_HD(std::size_t o) {
         const LsmObjectParams obj = d.objects[o];
         if (!obj.rigid) return;
@@ -314,8 +318,6 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
         // the deepest IBP past each, and the sum of the positions past it (relative to an anchor
         // IBP, as are all sums here, so that float keeps the body's size, not its place).
         Real depth[6] = {0, 0, 0, 0, 0, 0}, past[6] = {0, 0, 0, 0, 0, 0};
-        Vec3 where[6];
-        for (Vec3& w : where) w = Vec3{0, 0, 0};
         Vec3 anchor{0, 0, 0};
         bool anchored = false, touching = false;
         Real M = 0;
@@ -330,9 +332,8 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
             const Vec3 r = x - anchor;
             for (int a = 0; a < 3; ++a) {
                 const Real below = component(lo, a) - component(x, a), above = component(x, a) - component(hi, a);
-                if (below > Real(0)) depth[2 * a] = depth[2 * a] > below ? depth[2 * a] : below, where[2 * a] += r, past[2 * a] += 1;
-                if (above > Real(0))
-                    depth[2 * a + 1] = depth[2 * a + 1] > above ? depth[2 * a + 1] : above, where[2 * a + 1] += r, past[2 * a + 1] += 1;
+                if (below > Real(0)) depth[2 * a] = depth[2 * a] > below ? depth[2 * a] : below, past[2 * a] += 1;
+                if (above > Real(0)) depth[2 * a + 1] = depth[2 * a + 1] > above ? depth[2 * a + 1] : above, past[2 * a + 1] += 1;
                 touching = touching || below > Real(0) || above > Real(0);
             }
             const Real m = d.mass[s];
@@ -355,26 +356,42 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
             double(izz - M * (c.x * c.x + c.y * c.y)), double(ixy + M * c.x * c.y), double(ixz + M * c.x * c.z),
             double(iyz + M * c.y * c.z));
         Vec3 omega = inverse_inertia * L;
-        // An impulse j along unit u at r from c: V += j u / M, ω += I⁻¹ (r × j u); j for a change
-        // Δ of the velocity at r along u is Δ / (1/M + u · ((I⁻¹ (r × u)) × r)).
-        auto push = [&](Vec3 r, Vec3 u, Real change) {
-            const Real k = Real(1) / M + dot(u, cross(inverse_inertia * cross(r, u), r));
-            const Real j = change / k;
-            V += (j / M) * u;
-            omega += inverse_inertia * cross(r, j * u);
-        };
+        // Every IBP past a wall is a contact. Its impulse along the wall's normal n, accumulated
+        // over sweeps of the contacts in slot order and never negative (a wall pushes, never
+        // pulls), is what takes the body's velocity into the wall there to zero: the velocity at
+        // r from c along n changes by j (1/M + n · ((I⁻¹ (r × n)) × r)) for an impulse j. A box on
+        // a face so rests on the whole face; met at one point a step, the mean of the IBPs past a
+        // wall, it rocked about that point.
+        for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) wall_impulse[s] = Vec3{0, 0, 0};
+        for (int sweep = 0; sweep < kRigidWallSweeps; ++sweep) {
+            for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {
+                const std::uint32_t i = d.store_of_slot[s];
+                if (i == kMeltedSlot) continue;
+                const Vec3 x = d.position[i];
+                const Vec3 r = (x - anchor) - c;
+                for (int a = 0; a < 3; ++a) {
+                    const Real side = component(x, a) < component(lo, a)   ? Real(1)
+                                      : component(x, a) > component(hi, a) ? Real(-1)
+                                                                           : Real(0);
+                    if (side == Real(0)) continue;
+                    const Vec3 n = axis_vector(a, side);
+                    const Real k = Real(1) / M + dot(n, cross(inverse_inertia * cross(r, n), r));
+                    const Real before = side * component(wall_impulse[s], a);
+                    const Real vn = dot(V + cross(omega, r), n);
+                    const Real after = before - vn / k > Real(0) ? before - vn / k : Real(0);
+                    V += ((after - before) / M) * n;
+                    omega += inverse_inertia * cross(r, (after - before) * n);
+                    wall_impulse[s] += axis_vector(a, side * (after - before));
+                }
+            }
+        }
+        // Friction on the body's sliding, through its centre (it turns nothing), then the body out
+        // of every wall.
         Vec3 shift{0, 0, 0};
         for (int f = 0; f < 6; ++f) {
             if (!(past[f] > Real(0))) continue;
             const Vec3 n = axis_vector(f / 2, (f & 1) ? Real(-1) : Real(1));
-            const Vec3 r = where[f] / past[f] - c;
-            const Real vn = dot(V + cross(omega, r), n);
-            if (vn < Real(0)) push(r, n, -vn);
-            // Friction through the centre: at the contact point its torque would tip a sliding
-            // box about that one point, which nothing then holds (a box resting on a face rocked
-            // by 1.4 mm, 6 g Δt², after sliding to rest).
-            const Vec3 sliding = V - dot(V, n) * n;
-            if (obj.friction > Real(0)) V -= obj.friction * sliding;
+            if (obj.friction > Real(0)) V -= obj.friction * (V - dot(V, n) * n);
             shift += depth[f] * n;
         }
         for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {

@@ -105,6 +105,7 @@ class SolidBodies final : public Module {
         objects_.upload(L.objects);
         has_rigid_ = false;
         for (const auto& o : L.objects) has_rigid_ = has_rigid_ || o.rigid;
+        wall_impulse_.assign(has_rigid_ ? ibp_count_ : 0, Vec3{0, 0, 0});
         gp_rest_.upload(L.gp_rest);
         gp_offsets_.upload(L.gp_offsets);
         gp_links_.upload(L.gp_links);
@@ -261,7 +262,7 @@ class SolidBodies final : public Module {
         p.domain_min = domain_min;
         p.domain_max = domain_max;
         lsm_particle_update(device_, d, p);
-        if (has_rigid_) lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_);
+        if (has_rigid_) lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_, wall_impulse_.view().data());
         const InterpolationData g = interpolation(store);
         interpolate_geometry(device_, g, dt);
         interpolate_surface(device_, g);
@@ -418,7 +419,7 @@ class SolidBodies final : public Module {
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
-               object_ibp_begin_.bytes() + object_velocity_.bytes();
+               object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -521,6 +522,7 @@ class SolidBodies final : public Module {
     bool predicts_ = false;
     std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0, object_count_ = 0;
     bool has_rigid_ = false;  // any rigid object (lsm_rigid_walls)
+    DeviceArray<Vec3> wall_impulse_;  // per IBP of a rigid object, its walls' impulses this step
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;
     DeviceArray<Vec3> rest_;
