@@ -315,9 +315,9 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
         const Vec3 lo = p.domain_min + Vec3{obj.margin, obj.margin, obj.margin};
         const Vec3 hi = p.domain_max - Vec3{obj.margin, obj.margin, obj.margin};
         // Walls 2a (the low face of axis a, normal +e_a) and 2a + 1 (the high face, normal -e_a):
-        // the deepest IBP past each, and the sum of the positions past it (relative to an anchor
-        // IBP, as are all sums here, so that float keeps the body's size, not its place).
-        Real depth[6] = {0, 0, 0, 0, 0, 0}, past[6] = {0, 0, 0, 0, 0, 0};
+        // how deep the deepest IBP is past each (0: none). The body's sums are taken relative to
+        // an anchor IBP, so that float keeps the body's size, not its place.
+        Real depth[6] = {0, 0, 0, 0, 0, 0};
         Vec3 anchor{0, 0, 0};
         bool anchored = false, touching = false;
         Real M = 0;
@@ -332,8 +332,8 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
             const Vec3 r = x - anchor;
             for (int a = 0; a < 3; ++a) {
                 const Real below = component(lo, a) - component(x, a), above = component(x, a) - component(hi, a);
-                if (below > Real(0)) depth[2 * a] = depth[2 * a] > below ? depth[2 * a] : below, past[2 * a] += 1;
-                if (above > Real(0)) depth[2 * a + 1] = depth[2 * a + 1] > above ? depth[2 * a + 1] : above, past[2 * a + 1] += 1;
+                if (below > depth[2 * a]) depth[2 * a] = below;
+                if (above > depth[2 * a + 1]) depth[2 * a + 1] = above;
                 touching = touching || below > Real(0) || above > Real(0);
             }
             const Real m = d.mass[s];
@@ -389,7 +389,7 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
         // of every wall.
         Vec3 shift{0, 0, 0};
         for (int f = 0; f < 6; ++f) {
-            if (!(past[f] > Real(0))) continue;
+            if (!(depth[f] > Real(0))) continue;
             const Vec3 n = axis_vector(f / 2, (f & 1) ? Real(-1) : Real(1));
             if (obj.friction > Real(0)) V -= obj.friction * (V - dot(V, n) * n);
             shift += depth[f] * n;
