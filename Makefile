@@ -15,7 +15,8 @@ build: setup
 
 demo: setup
 	@cmake --build $(BUILD_DIR) -j $(JOBS) --target meltwater
-	@$(BUILD_DIR)/meltwater run --out $(OUT)
+	@$(BUILD_DIR)/meltwater run --out $(OUT) --set 'output.formats=["vtu","preview"]'
+	@$(BUILD_DIR)/meltwater plot $(OUT)
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

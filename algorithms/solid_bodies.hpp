@@ -133,6 +133,11 @@ class SolidBodies final : public Module {
         for (std::size_t o = 0; o < object_count_; ++o) ibp_begin[o + 1] += ibp_begin[o];
         object_ibp_begin_.upload(ibp_begin);
         object_velocity_.assign(object_count_, Vec3{0, 0, 0});
+        object_centroid_.assign(object_count_, Vec3{0, 0, 0});
+        centroid_host_.assign(object_count_, Vec3{0, 0, 0});
+        moving_names_.clear();
+        for (std::size_t o = 0; o < object_count_; ++o)
+            moving_names_.push_back(setup.solids[o].kind != SolidKind::kStatic ? setup.solids[o].name : "");
         // Interface tension (interface_tension.hpp): each SBP's η, its object's; none stored when
         // no object has any.
         std::vector<Real> sbp_eta(sbp_count_, Real(0));
@@ -267,6 +272,39 @@ class SolidBodies final : public Module {
         interpolate_geometry(device_, g, dt);
         interpolate_surface(device_, g);
         return summary(store);
+    }
+
+    // stats.csv: each moving object's centre of mass (of its IBPs that have not melted), m, as
+    // NAME_x, NAME_y, NAME_z: how a body sinks, floats or drifts, step by step.
+    void report_columns(std::vector<std::string>& names) const override {
+        for (const std::string& name : moving_names_)
+            if (!name.empty())
+                for (const char* axis : {"_x", "_y", "_z"}) names.push_back("centroid_" + name + axis);
+    }
+    void report(std::vector<double>& values) const override {
+        if (object_count_ == 0 || !store_) return;
+        // One thread per object over its IBP slots in order: deterministic. One small copy to
+        // the host, with the report's other sums.
+        const Vec3* position = store_->position.cview().data();
+        const std::uint32_t* store_of_slot = store_of_slot_.view().data();
+        const std::uint32_t* begin = object_ibp_begin_.view().data();
+        const Real* mass = mass_.view().data();
+        Vec3* centroid = object_centroid_.view().data();
+        parallel_for(device_, "solid_object_centroid", object_count_, [=] MW_HD(std::size_t o) {
+            Vec3 first_moment{0, 0, 0};
+            Real total = 0;
+            for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
+                if (store_of_slot[s] == kMeltedSlot) continue;
+                first_moment += mass[s] * position[store_of_slot[s]];
+                total += mass[s];
+            }
+            centroid[o] = total > Real(0) ? first_moment / total : Vec3{0, 0, 0};
+        });
+        object_centroid_.download(centroid_host_);
+        for (std::size_t o = 0; o < object_count_; ++o)
+            if (!moving_names_[o].empty())
+                values.insert(values.end(), {double(centroid_host_[o].x), double(centroid_host_[o].y),
+                                             double(centroid_host_[o].z)});
     }
 
     // Where PCISPH meets the moving solids this step (pcisph.hpp, SolidLookahead): each soft
@@ -561,6 +599,9 @@ class SolidBodies final : public Module {
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
     DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
+    mutable DeviceArray<Vec3> object_centroid_;    // per object, its centre of mass (report())
+    mutable std::vector<Vec3> centroid_host_;      // host: the same
+    std::vector<std::string> moving_names_;        // per object, its name ("" for a static one)
     std::vector<std::int32_t> sbp_object_;  // host: each SBP's object
     std::vector<MeltingLattice> melting_;   // host: the melting objects' lattices
     LsmHostLayout host_layout_;             // host: the layout, kept only when an object melts

@@ -5,6 +5,7 @@
 
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
+#include "apps/run_estimate.hpp"
 #include "apps/scene_builder.hpp"
 #include "apps/speed_limit.hpp"
 #include "simulation/factory.hpp"
@@ -28,7 +29,29 @@ struct InfoFacts {
     std::vector<std::string> stages, warnings;
     long frames = 0;
     long moving_objects = 0;
+    DiskEstimate disk;
+    TimeEstimate time;
+    std::string time_note;  // why no time was measured ("" when it was)
 };
+
+// Times `steps` steps on the backend a run would use: the host probe is an OpenMP simulation; a
+// CUDA run is timed on the GPU when there is one.
+void measure_time(InfoFacts& f, int steps) {
+    if (steps <= 0) {
+        f.time_note = "not measured (--time-steps 0)";
+        return;
+    }
+    if (f.backend == "openmp") {
+        f.time = time_steps(*f.probe, f.scene, f.scene.end_time, steps);
+        return;
+    }
+    if (!cuda_backend_info().available) {
+        f.time_note = "not measured: no GPU here for the cuda backend";
+        return;
+    }
+    const std::unique_ptr<Simulation> sim = create_simulation(f.setup, "cuda", 0);
+    f.time = time_steps(*sim, f.scene, f.scene.end_time, steps);
+}
 
 InfoFacts gather(const Scene& scene, const std::string& backend) {
     InfoFacts f;
@@ -49,6 +72,7 @@ InfoFacts gather(const Scene& scene, const std::string& backend) {
     f.frames = scene.writes_frames() ? 1 + static_cast<long>(std::floor(scene.end_time * scene.fps + 1e-9)) : 0;
     f.moving_objects = std::count_if(scene.objects.begin(), scene.objects.end(),
                                      [](const SceneObject& o) { return o.kind != SolidKind::kStatic; });
+    f.disk = estimate_disk(scene, f.counts, f.setup);
     return f;
 }
 
@@ -71,6 +95,15 @@ void print_json(const InfoFacts& f) {
     if (scene.params.heat.enabled)  // the sub-steps the largest step needs, before heat.max_substeps
         j["heat_substeps_needed"] = f.probe->heat_substeps_needed(double(scene.params.solver.dt));
     j["frames"] = f.frames;
+    SceneJson disk;
+    for (const auto& [name, bytes] : f.disk.parts) disk[name] = bytes;
+    j["disk_estimate"] = {{"bytes", f.disk.total}, {"by_kind", disk}, {"surface_from_start", f.disk.surface_estimated}};
+    if (f.time.steps_timed > 0)
+        j["time_estimate"] = {{"steps_timed", f.time.steps_timed}, {"ms_per_step", f.time.ms_per_step},
+                              {"steps_to_end", f.time.steps_to_end}, {"seconds", f.time.seconds},
+                              {"lower_bound", f.time.lower_bound}};
+    else
+        j["time_estimate"] = nullptr;
     j["speed_limit"] = f.runaway.limit > 0 ? SceneJson(f.runaway.limit) : SceneJson(nullptr);  // m/s
     if (!f.setup.emitters.empty()) {
         SceneJson list = SceneJson::array();
@@ -100,6 +133,27 @@ void print_counts(const InfoFacts& f) {
     std::printf("stages     ");
     for (std::size_t i = 0; i < f.stages.size(); ++i) std::printf("%s %s", i ? "," : "", f.stages[i].c_str());
     std::printf("\n");
+}
+
+// The disk the frames take and the time the steps take (apps/run_estimate.hpp).
+void print_estimates(const InfoFacts& f) {
+    std::string parts;
+    for (const auto& [name, bytes] : f.disk.parts) parts += (parts.empty() ? "" : ", ") + name + " " + format_bytes(bytes);
+    if (f.disk.frames > 0)
+        std::printf("disk        about %s for %s: %s%s\n", format_bytes(f.disk.total).c_str(),
+                    count_of(f.disk.frames, "frame").c_str(), parts.c_str(),
+                    f.disk.surface_estimated ? " (surfaces sized from the fluid's start; splashes enlarge them)" : "");
+    else
+        std::printf("disk        no frames (output.formats is empty): stats.csv and summary.json only\n");
+    if (f.time.steps_timed == 0) {
+        std::printf("time        %s\n", f.time_note.c_str());
+        return;
+    }
+    std::printf("time        %.3g ms/step over %d steps timed here on %s; %s%s steps to t=%g s: about %s%s\n",
+                f.time.ms_per_step, f.time.steps_timed, f.backend.c_str(), f.time.lower_bound ? "at least " : "",
+                with_thousands(long(f.time.steps_to_end)).c_str(), f.scene.end_time,
+                format_duration(f.time.seconds).c_str(),
+                f.time.lower_bound ? " or more (CFL steps shorten as the fluid speeds up)" : "");
 }
 
 void print_fluid_and_run(const InfoFacts& f) {
@@ -136,6 +190,7 @@ void print_fluid_and_run(const InfoFacts& f) {
         std::printf("; more than %g%% of the fluid lost (boundary.max_lost_fraction)", 100 * scene.max_lost_fraction);
     if (f.runaway.limit > 0) std::printf("; a particle faster than %s\n", describe(f.runaway).c_str());
     else std::printf("; no speed limit (solver.max_speed: no gravity, motion or emitter to scale one by)\n");
+    print_estimates(f);
     if (scene.writes_surface())
         std::printf("surface     the fluid's surface with every frame (frames/surface_NNNNN.obj): its colour field on "
                     "nodes %g r0 apart, meshed%s\n",
@@ -264,7 +319,9 @@ int command_info(int argc, char** argv) {
     add_scene_options(options);
     options.add_options()("json", "print one JSON object instead of text")(
         "backend", "the backend whose memory layout to estimate: auto (what run would use), cuda or openmp",
-        cxxopts::value<std::string>()->default_value("auto"), "NAME");
+        cxxopts::value<std::string>()->default_value("auto"), "NAME")(
+        "time-steps", "steps to time for the run's time estimate (0: none)", cxxopts::value<int>()->default_value("3"),
+        "N");
     std::vector<std::string> overrides;
     const cxxopts::ParseResult args = parse_options(options, argc, argv, &overrides);
     if (flag_option(args, "help")) {
@@ -277,7 +334,11 @@ int command_info(int argc, char** argv) {
     const std::string requested = args["backend"].as<std::string>();
     if (requested != "auto" && requested != "cuda" && requested != "openmp")
         throw InputError("--backend: expected auto, cuda or openmp, got '" + requested + "'");
-    const InfoFacts facts = gather(scene, requested == "auto" ? choose_backend("auto") : requested);
+    const int time_steps_wanted = args["time-steps"].as<int>();
+    if (time_steps_wanted < 0 || time_steps_wanted > 1000)
+        throw InputError("--time-steps must be 0 to 1000, got " + std::to_string(time_steps_wanted));
+    InfoFacts facts = gather(scene, requested == "auto" ? choose_backend("auto") : requested);
+    measure_time(facts, time_steps_wanted);
     if (flag_option(args, "json")) {
         print_json(facts);
         return 0;

@@ -11,6 +11,9 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
+#include "apps/frame_writer.hpp"
+#include "apps/preview_picture.hpp"
+#include "apps/run_guards.hpp"
 #include "apps/run_outputs.hpp"
 #include "apps/scene_builder.hpp"
 #include "apps/speed_limit.hpp"
@@ -49,53 +52,6 @@ class StopSignals {
 int report_interrupted_setup() {
     std::fprintf(stderr, "meltwater: interrupted during set-up, before the first step; nothing was written\n");
     return 130;
-}
-
-// What PCISPH did before a run stopped: the steps integrated after the iteration diverged or ran
-// out of iterations (columns diverged and unconverged of stats.csv), or "" if none.
-std::string failed_iterations_hint(const StatsTable& stats) {
-    std::string hint;
-    if (stats.diverged_steps() > 0) hint += "diverged in " + count_of(stats.diverged_steps(), "step");
-    if (stats.unconverged_steps() > 0)
-        hint += (hint.empty() ? "" : " and ") + std::string("ran out of iterations above its tolerance in ") +
-                count_of(stats.unconverged_steps(), "step");
-    if (hint.empty()) return hint;
-    return "; PCISPH " + hint + " so far (columns diverged and unconverged of stats.csv): use a smaller dt, or "
-           "dt_mode \"cfl\"";
-}
-
-// The lost-fluid guard's message: the step, how much fluid left, the limit, and the likely cause.
-std::string lost_fluid_message(const StepReport& r, long fluid_count, const StatsTable& stats, const Scene& scene) {
-    char head[200];
-    std::snprintf(head, sizeof head, "step %ld (t = %.6g s): %s of %s (%.3g%%) have left the domain, more than ",
-                  r.step, r.time, with_thousands(r.lost_particles).c_str(),
-                  count_of(fluid_count, "fluid particle").c_str(), 100.0 * double(r.lost_particles) / double(fluid_count));
-    const std::string hint = failed_iterations_hint(stats);
-    return head + ("boundary.max_lost_fraction " + format_number(scene.max_lost_fraction)) +
-           (!hint.empty() ? hint
-                          : std::string("; the fluid leaked through the walls or blew up (see the last frames "
-                                        "and stats.csv)"));
-}
-
-std::string density_blowup_message(const StepReport& r, const StatsTable& stats, const Scene& scene) {
-    char head[200];
-    std::snprintf(head, sizeof head,
-                  "step %ld (t = %.6g s): the fluid is packed %.3g%% above its rest density, more than ", r.step,
-                  r.time, 100.0 * r.density_error_max);
-    const std::string hint = failed_iterations_hint(stats);
-    return head + ("solver.max_density_error " + format_number(scene.max_density_error)) +
-           (!hint.empty() ? hint : std::string("; the run blew up (see the last frames and stats.csv)"));
-}
-
-std::string runaway_message(const StepReport& r, const SpeedLimit& limit, const StatsTable& stats) {
-    const bool solid = r.solid_max_speed > r.max_speed;
-    char head[200];
-    std::snprintf(head, sizeof head, "step %ld (t = %.6g s, dt = %.3g s): %s moves at %.4g m/s, more than ", r.step,
-                  r.time, r.dt, solid ? "a solid's particle" : "a fluid particle",
-                  solid ? r.solid_max_speed : r.max_speed);
-    const std::string hint = failed_iterations_hint(stats);
-    return head + describe(limit) +
-           (!hint.empty() ? hint : std::string("; the run blew up (see the last frames and stats.csv)"));
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -205,6 +161,9 @@ class Run {
     RunSummary summary_;
     std::unique_ptr<FluidSurfacer> surfacer_;
     std::vector<double> surface_ms_, surface_field_ms_;  // per mesh: all of it, and the colour field's part
+    TriangleMesh last_surface_;                          // the frame's surface, for its preview
+    std::vector<double> preview_ms_;                     // per preview: drawing, encoding and writing
+    std::string last_preview_;                           // the last preview's path
     HostParticles host_;
     double frame_dt_ = 0, next_frame_time_ = 0;
     long checkpoint_step_ = -1;
@@ -302,7 +261,7 @@ void Run::open_outputs() {
     }
     if (resume_) frame_times_ = resume_->frame_times;
     if (scene_.writes_frames()) {
-        frames_ = std::make_unique<FrameWriter>(out_dir_, scene_.writes_vtu());
+        frames_ = std::make_unique<FrameWriter>(out_dir_, scene_.frame_formats());
         frames_->set_objects(setup_.solids);
         if (continues_directory_) frames_->keep_earlier(frame_times_);
     }
@@ -366,8 +325,9 @@ void Run::write_frame() {
     if (!frames_) return;
     sim_->download(host_);
     frames_->write(frame_index_, host_, sim_->time());
-    if (scene_.writes_surface()) {
-        const FluidSurfacer::Surface surface = surfacer_->build(*sim_, host_);
+    const FrameFormats& formats = frames_->formats();
+    if (formats.surface) {
+        FluidSurfacer::Surface surface = surfacer_->build(*sim_, host_);
         frames_->write_surface(frame_index_, surface.mesh);
         surface_ms_.push_back(surface.ms);
         surface_field_ms_.push_back(surface.field_ms);
@@ -375,6 +335,22 @@ void Run::write_frame() {
         summary_.surface_ms_median = median_of(surface_ms_);
         summary_.surface_field_ms_median = median_of(surface_field_ms_);
         summary_.surface_triangles_last = static_cast<long>(surface.mesh.triangles.size());
+        if (formats.preview) last_surface_ = std::move(surface.mesh);
+    }
+    if (formats.vdb) {
+        // The surface's field when it was just computed, else this frame's own.
+        const FluidSurfacer::Field& field = formats.surface ? surfacer_->last_field() : surfacer_->field(*sim_, host_);
+        frames_->write_fluid_grids(frame_index_, field);
+    }
+    if (formats.preview) {
+        const auto start = std::chrono::steady_clock::now();
+        std::vector<PreviewMesh> meshes = object_preview_meshes(setup_.solids, host_);
+        if (formats.surface) meshes.push_back(surface_preview_mesh(last_surface_));
+        last_preview_ = frames_->write_preview(
+            frame_index_, preview_picture(scene_, host_, std::move(meshes), sim_->time(), frame_index_, runaway_.scale()));
+        preview_ms_.push_back(seconds_since(start) * 1000);
+        summary_.previews = static_cast<int>(preview_ms_.size());
+        summary_.preview_ms_median = median_of(preview_ms_);
     }
     frame_times_.push_back(sim_->time());
     ++frame_index_;
@@ -402,18 +378,11 @@ void Run::write_checkpoint_now() {
 // The run stops at the step that passes a guard (docs/running.md).
 void Run::check_guards(const StepReport& r, Progress& progress) {
     // Against the fluid there is now: melting objects add to it (the counts are host figures).
-    const long fluid_now = sim_->counts().by_type[kFluid];
-    if (r.lost_particles > scene_.max_lost_fraction * double(fluid_now)) {
+    try {
+        check_run_guards(r, sim_->counts().by_type[kFluid], *stats_, scene_, runaway_);
+    } catch (...) {
         progress.finish();
-        throw SimulationError(lost_fluid_message(r, fluid_now, *stats_, scene_));
-    }
-    if (r.density_error_max > scene_.max_density_error) {
-        progress.finish();
-        throw SimulationError(density_blowup_message(r, *stats_, scene_));
-    }
-    if (runaway_.limit > 0 && std::max(r.max_speed, r.solid_max_speed) > runaway_.limit) {
-        progress.finish();
-        throw SimulationError(runaway_message(r, runaway_, *stats_));
+        throw;
     }
 }
 
@@ -436,9 +405,8 @@ void Run::step_loop() {
             // A step can still allocate (neighbour lists growing as the flow compresses): say where
             // the run stood and what it held.
             progress.finish();
-            throw DeviceError(std::string(e.what()) + " (in step " + std::to_string(steps_done + 1) + "; the " +
-                              with_thousands(long(summary_.particles.total())) + " particles held " +
-                              format_bytes(double(summary_.device_bytes)) + " before it)");
+            throw DeviceError(device_error_in_step(e.what(), steps_done + 1, long(summary_.particles.total()),
+                                                   summary_.device_bytes));
         } catch (...) {
             progress.finish();
             throw;
@@ -484,6 +452,17 @@ bool Run::record_end() {
     summary_.synced_files = synced.files - synced_at_start_.files;
     summary_.sync_seconds = synced.seconds - synced_at_start_.seconds;
     summary_.frames = frames_ ? frames_->written() : 0;
+    // The counts by type now (an emitter's released fluid is fluid, a melted solid's too): one
+    // host copy at the end.
+    try {
+        sim_->download(host_);
+        ParticleCounts at_end;
+        for (std::uint8_t type : host_.type)
+            if (type < kParticleTypeCount) ++at_end.by_type[type];
+        summary_.particles_at_end = at_end;
+    } catch (const std::exception&) {
+        summary_.particles_at_end.reset();  // a device that failed: not known
+    }
     if (failure_) {
         summary_.status = "failed";
         try {
@@ -546,6 +525,11 @@ int Run::print_end() {
     std::printf("meltwater: results in %s (%s%s in frames/, stats.csv, summary.json%s)\n",
                 ec ? out_dir_.c_str() : shown.c_str(), count_of(summary_.frames, "frame").c_str(), surfaces.c_str(),
                 summary_.checkpoint.empty() ? "" : ", checkpoint.mwc");
+    // Where a person can look first: the last picture, or how to draw one.
+    if (!last_preview_.empty()) {
+        const std::string picture = std::filesystem::absolute(last_preview_, ec).lexically_normal().string();
+        std::printf("meltwater: picture of the last frame: %s\n", ec ? last_preview_.c_str() : picture.c_str());
+    }
     if (!summary_.checkpoint.empty() && !o_.quiet)
         std::fprintf(stderr, "meltwater: checkpoint at step %ld (t = %.6g s); continue with: meltwater run --resume %s "
                      "--time T\n", summary_.checkpoint_step, summary_.simulated_time, summary_.checkpoint.c_str());

@@ -8,4 +8,6 @@ int command_info(int argc, char** argv);
 int command_backends(int argc, char** argv);
 int command_sample(int argc, char** argv);
 int command_schema(int argc, char** argv);
+int command_plot(int argc, char** argv);
+int command_render(int argc, char** argv);
 }  // namespace mw

@@ -18,6 +18,8 @@ void print_usage(std::FILE* to) {
         "  backends         the backends compiled in and the devices found\n"
         "  sample MESH      sample a mesh into surface, inner and geometry particles\n"
         "  schema           every scene key with its default and meaning; --stages: the time step\n"
+        "  plot RUN_DIR     draw a run's stats.csv (step size, errors, speeds, stage times) as a PNG\n"
+        "  render RUN_DIR   draw a run's frames as pictures (frames/preview_NNNNN.png)\n"
         "Run 'meltwater <command> --help' for the options of a command; 'meltwater --version' for the version.\n");
 }
 }  // namespace
@@ -38,7 +40,9 @@ int main(int argc, char** argv) {
         if (command == "backends") return mw::command_backends(argc - 1, argv + 1);
         if (command == "sample") return mw::command_sample(argc - 1, argv + 1);
         if (command == "schema") return mw::command_schema(argc - 1, argv + 1);
-        std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample, schema)\n",
+        if (command == "plot") return mw::command_plot(argc - 1, argv + 1);
+        if (command == "render") return mw::command_render(argc - 1, argv + 1);
+        std::fprintf(stderr, "meltwater: error: unknown command '%s' (run, info, backends, sample, schema, plot, render)\n",
                      mw::printable(command.c_str()).c_str());
         return 2;
     } catch (const mw::InputError& e) {

@@ -12,7 +12,7 @@
 
 #include "apps/atomic_file.hpp"
 #include "apps/checkpoint_file.hpp"
-#include "apps/vtu_writer.hpp"
+#include "apps/frame_writer.hpp"
 #include "common/errors.hpp"
 
 namespace mw {
@@ -25,46 +25,8 @@ double median_of(std::vector<double> v) {
 }
 
 namespace {
-std::vector<float> to_floats(const std::vector<Real>& v) { return std::vector<float>(v.begin(), v.end()); }
-
 // JSON numbers must be finite; a NaN would make nlohmann write `null` anyway, say so explicitly.
 SceneJson finite_or_null(double v) { return std::isfinite(v) ? SceneJson(v) : SceneJson(nullptr); }
-}  // namespace
-
-namespace {
-// An OBJ file, atomically: a comment line, vertex_at(0 .. vertex_count - 1) (x, y, z), and the
-// triangles (0-based here, 1-based in the file).
-template <class VertexAt>
-void write_obj(const std::string& path, const std::string& comment, std::size_t vertex_count, VertexAt vertex_at,
-               const std::vector<std::array<int, 3>>& triangles) {
-    write_file_atomically(path, [&](std::ostream& out) {
-        out << "# " << comment << "\n";
-        char line[128];
-        for (std::size_t v = 0; v < vertex_count; ++v) {
-            const std::array<double, 3> x = vertex_at(v);
-            std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", x[0], x[1], x[2]);
-            out << line;
-        }
-        for (const auto& t : triangles) {
-            std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
-            out << line;
-        }
-    });
-}
-
-// The NNNNN of a frame's file name (particles_NNNNN.vtu, object_NAME_NNNNN.obj), or -1.
-int frame_number(const std::string& name, const std::string& extension) {
-    const std::size_t digits = 5;
-    if (name.size() < digits + extension.size() + 1) return -1;
-    const std::size_t first = name.size() - extension.size() - digits;
-    if (name[first - 1] != '_') return -1;
-    int number = 0;
-    for (std::size_t k = first; k < first + digits; ++k) {
-        if (name[k] < '0' || name[k] > '9') return -1;
-        number = number * 10 + (name[k] - '0');
-    }
-    return number;
-}
 }  // namespace
 
 RemovedOutputs remove_earlier_outputs(const std::string& out_dir, int keep_frames_below, bool keep_records) {
@@ -78,11 +40,8 @@ RemovedOutputs remove_earlier_outputs(const std::string& out_dir, int keep_frame
             // A frame's temporary (NAME.tmp.PID) is left only by a run killed mid-write.
             const std::size_t tmp = name.find(".tmp.");
             const std::string frame_name = tmp == std::string::npos ? name : name.substr(0, tmp);
-            const std::string extension = std::filesystem::path(frame_name).extension().string();
-            const bool frame = (frame_name.rfind("particles_", 0) == 0 && extension == ".vtu") ||
-                               ((frame_name.rfind("object_", 0) == 0 || frame_name.rfind("surface_", 0) == 0) &&
-                                extension == ".obj");
-            const int number = frame ? frame_number(frame_name, extension) : -1;
+            const int number = frame_file_number(frame_name);
+            const bool frame = number >= 0 || is_frame_file(frame_name);
             const bool kept = tmp == std::string::npos && number >= 0 && number < keep_frames_below;
             if ((frame && !kept) || frame_name == "particles.pvd") std::filesystem::remove(entry.path(), error);
             if (frame && !kept && tmp == std::string::npos && number >= 0) frame_numbers.insert(number);
@@ -103,107 +62,6 @@ RemovedOutputs remove_earlier_outputs(const std::string& out_dir, int keep_frame
                 std::filesystem::remove(out_dir + "/" + name, error))
                 removed.records.push_back(name);
     return removed;
-}
-
-FrameWriter::FrameWriter(const std::string& out_dir, bool particles)
-    : frames_dir_(out_dir + "/frames"), particles_(particles) {
-    make_directories(frames_dir_);
-}
-
-std::string FrameWriter::particles_name(int index) {
-    char name[64];
-    std::snprintf(name, sizeof name, "particles_%05d.vtu", index);
-    return name;
-}
-
-std::string FrameWriter::write(int index, const HostParticles& p, double time) {
-    if (!particles_) {  // surfaces only: the objects' meshes go with them
-        write_objects(index, p);
-        ++written_;
-        return "";
-    }
-    const std::string name = particles_name(index);
-    const std::string path = frames_dir_ + "/" + name;
-    // An emitter's particles not released yet are not in the scene: left out, so a frame holds
-    // what has been emitted by its time (frames of a scene with emitters grow).
-    const bool pending = std::find(p.type.begin(), p.type.end(), std::uint8_t(kPending)) != p.type.end();
-    HostParticles released;
-    if (pending) {
-        for (std::size_t i = 0; i < p.type.size(); ++i) {
-            if (p.type[i] == kPending) continue;
-            released.position.push_back(p.position[i]);
-            released.velocity.push_back(p.velocity[i]);
-            released.density.push_back(p.density[i]);
-            released.pressure.push_back(p.pressure[i]);
-            released.type.push_back(p.type[i]);
-            released.object.push_back(p.object[i]);
-            if (!p.temperature.empty()) released.temperature.push_back(p.temperature[i]);
-        }
-    }
-    const HostParticles& shown = pending ? released : p;
-    std::vector<VtuArray> arrays;
-    arrays.push_back(VtuArray::vector3("velocity", shown.velocity));
-    arrays.push_back(VtuArray::scalar("density", to_floats(shown.density)));
-    arrays.push_back(VtuArray::scalar("pressure", to_floats(shown.pressure)));
-    arrays.push_back(VtuArray::uint8("type", shown.type));
-    arrays.push_back(VtuArray::int32("object", shown.object));
-    if (!shown.temperature.empty()) arrays.push_back(VtuArray::scalar("temperature", to_floats(shown.temperature)));
-    write_vtu(path, shown.position, arrays);
-    write_objects(index, p);  // the objects' GPs by their scene index, in the whole list
-    ++written_;
-    collection_.emplace_back(time, name);
-    write_collection();
-    return path;
-}
-
-void FrameWriter::keep_earlier(const std::vector<double>& frame_times) {
-    collection_.clear();
-    for (std::size_t k = 0; k < frame_times.size(); ++k) {
-        const std::string name = particles_name(static_cast<int>(k));
-        if (std::filesystem::exists(frames_dir_ + "/" + name)) collection_.emplace_back(frame_times[k], name);
-    }
-    write_collection();
-}
-
-void FrameWriter::write_collection() const {
-    write_file_atomically(frames_dir_ + "/particles.pvd", [&](std::ostream& out) {
-        out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
-        char line[160];
-        for (const auto& [t, file] : collection_) {
-            std::snprintf(line, sizeof line, "    <DataSet timestep=\"%.9g\" part=\"0\" file=\"%s\"/>\n", t, file.c_str());
-            out << line;
-        }
-        out << "  </Collection>\n</VTKFile>\n";
-    });
-}
-
-void FrameWriter::write_surface(int index, const TriangleMesh& mesh) const {
-    char name[64];
-    std::snprintf(name, sizeof name, "/surface_%05d.obj", index);
-    const std::string header = "meltwater fluid surface, frame " + std::to_string(index) + ": " +
-                               std::to_string(mesh.vertices.size()) + " vertices, " +
-                               std::to_string(mesh.triangles.size()) + " triangles";
-    write_obj(frames_dir_ + name, header, mesh.vertices.size(), [&](std::size_t v) {
-        const Vec3d& x = mesh.vertices[v];
-        return std::array<double, 3>{x.x(), x.y(), x.z()};
-    },
-              mesh.triangles);
-}
-
-void FrameWriter::write_objects(int index, const HostParticles& p) const {
-    for (const SolidSetup& o : objects_) {
-        if (o.triangles.empty()) continue;  // a static box: no mesh
-        char name[64];
-        std::snprintf(name, sizeof name, "_%05d.obj", index);
-        const bool moving = o.kind != SolidKind::kStatic;
-        write_obj(frames_dir_ + "/object_" + o.name + name, "meltwater object " + o.name + ", frame " + std::to_string(index),
-                  moving ? o.gp.size() : o.rest_vertices.size(),
-                  [&](std::size_t g) {
-                      const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
-                      return std::array<double, 3>{double(x.x), double(x.y), double(x.z)};
-                  },
-                  o.triangles);
-    }
 }
 
 StatsTable::StatsTable(std::vector<std::string> stage_names, std::vector<std::string> columns)
@@ -350,10 +208,14 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
     j["steps"] = run.steps;
     j["simulated_time"] = finite_or_null(run.simulated_time);
     j["wall_seconds"] = run.wall_seconds;
-    SceneJson particles;
-    for (int t = 0; t < kParticleTypeCount; ++t) particles[particle_type_name(t)] = run.particles.by_type[t];
-    particles["total"] = run.particles.total();
-    j["particles"] = particles;
+    const auto counts = [](const ParticleCounts& c) {
+        SceneJson by_type;
+        for (int t = 0; t < kParticleTypeCount; ++t) by_type[particle_type_name(t)] = c.by_type[t];
+        by_type["total"] = c.total();
+        return by_type;
+    };
+    j["particles"] = counts(run.particles);
+    if (run.particles_at_end) j["particles_at_end"] = counts(*run.particles_at_end);
     j["fluid_carved"] = run.fluid_carved;
     j["lost_particles"] = run.lost_particles;
     SceneJson ms;
@@ -366,6 +228,7 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
                         {"ms_per_mesh", run.surface_ms_median},
                         {"field_ms_per_mesh", run.surface_field_ms_median},
                         {"triangles_last", run.surface_triangles_last}};
+    if (scene.frame_formats().preview) j["preview"] = {{"pictures", run.previews}, {"ms_per_picture", run.preview_ms_median}};
     const double step_seconds = stats.sum_total_ms() / 1000.0;
     j["particle_steps_per_second"] =
         step_seconds > 0 ? double(run.particles.total()) * double(stats.rows()) / step_seconds : 0.0;

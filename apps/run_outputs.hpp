@@ -1,23 +1,21 @@
-// What `meltwater run` writes into its output directory, each file atomically:
-//   frames/particles_NNNNN.vtu   the particles (velocity, density, pressure, type, object)
-//   frames/object_NAME_NNNNN.obj the deformed mesh (GP positions) of each solid object, same NNNNN
-//   frames/surface_NNNNN.obj     the fluid's surface (surface/fluid_surface.hpp), same NNNNN
+// What `meltwater run` records besides its frames (apps/frame_writer.hpp), each file atomically:
 //   stats.csv                    one row per step
 //   summary.json                 the run in one object, the resolved scene included
+// and the clearing of an earlier run's outputs from the directory.
 #pragma once
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "simulation/simulation.hpp"
 #include "apps/scene.hpp"
-#include "surface/fluid_surface.hpp"
 
 namespace mw {
 
 // Frames of an earlier run into the same directory would mix with this run's, or sit next to a
-// summary that says it wrote none: remove them (particles_*.vtu, particles.pvd, object_*.obj, surface_*.obj,
-// and the temporaries of a killed run), and frames/ itself when that leaves it empty. Run before
+// summary that says it wrote none: remove them (every file is_frame_file names, and the
+// temporaries of a killed run), and frames/ itself when that leaves it empty. Run before
 // every run, with or without frames. A run resumed in its checkpoint's directory keeps the
 // frames numbered below `keep_frames_below` (those written before the checkpoint) and the earlier
 // run's records; any other run removes those too (stats.csv, summary.json, checkpoint.mwc), so
@@ -37,41 +35,6 @@ struct EarlierStatsRows {
     std::string problem;
 };
 EarlierStatsRows stats_rows_up_to(const std::string& path, const std::string& header, long last_step);
-
-// Writes frames/particles_NNNNN.vtu (and the objects' meshes, once set_objects() was called),
-// and the fluid's surface meshes (write_surface).
-class FrameWriter {
-   public:
-    // Creates frames/. `particles`: write the particle frames (output.formats "vtu").
-    explicit FrameWriter(const std::string& out_dir, bool particles = true);
-    // The solid objects whose meshes go with every frame (static ones: their rest mesh).
-    // A melting object has no mesh to write (its lattice is all of it): its particles show it.
-    void set_objects(const std::vector<SolidSetup>& solids) {
-        objects_.clear();
-        for (const SolidSetup& o : solids)
-            if (!o.melts()) objects_.push_back(o);
-    }
-    // Writes frame `index` (simulated time `time`) and rewrites frames/particles.pvd, the ParaView
-    // collection listing every frame with its time. Returns the frame's path.
-    std::string write(int index, const HostParticles& particles, double time);
-    // frames/surface_NNNNN.obj: the fluid's surface at frame `index`.
-    void write_surface(int index, const TriangleMesh& mesh) const;
-    // A resumed run in its checkpoint's directory: frames 0 .. frame_times.size() - 1 (those of
-    // them still there), which particles.pvd keeps listing before the new ones; rewrites it at once.
-    void keep_earlier(const std::vector<double>& frame_times);
-    int written() const { return written_; }  // by this run
-    const std::string& directory() const { return frames_dir_; }
-
-   private:
-    static std::string particles_name(int index);  // particles_NNNNN.vtu
-    void write_objects(int index, const HostParticles& particles) const;
-    void write_collection() const;
-    std::string frames_dir_;
-    bool particles_ = true;
-    std::vector<SolidSetup> objects_;
-    int written_ = 0;
-    std::vector<std::pair<double, std::string>> collection_;
-};
 
 // Per-step statistics: each row is formatted once, when added, and the whole table is rewritten
 // atomically (so stats.csv is always whole). The numbers the summary needs are kept as columns.
@@ -132,7 +95,9 @@ struct RunSummary {
     double simulated_time = 0;
     double wall_seconds = 0;
     long lost_particles = 0;
-    ParticleCounts particles;
+    ParticleCounts particles;         // at the start
+    // At the end, fluid released by emitters and melted from solids included (none: unknown).
+    std::optional<ParticleCounts> particles_at_end;
     long fluid_carved = 0;  // fluid particles left out where static boxes and objects stand
     std::size_t device_bytes = 0;
     double speed_limit = 0;  // m/s: the runaway guard's (speed_limit.hpp); 0 when there is none
@@ -143,6 +108,9 @@ struct RunSummary {
     double surface_ms_median = 0;
     double surface_field_ms_median = 0;  // of which the colour field (grid build, field, host copy)
     long surface_triangles_last = 0;
+    // Previews (output.formats "preview"): pictures written, the median time one took.
+    int previews = 0;
+    double preview_ms_median = 0;
     std::string stop_condition;  // "steps N" or "time T s"
     std::vector<std::string> warnings;  // about the scene, given before the run (Scene::kernel_warning)
     // A resumed run: the checkpoint it started from, and that checkpoint's step and time.

@@ -14,6 +14,7 @@
 #include "apps/scene_section.hpp"
 #include "common/errors.hpp"
 #include "sampling/wall_gap.hpp"
+#include "render/preview.hpp"
 #include "surface/fluid_surface.hpp"
 
 namespace mw {
@@ -25,6 +26,21 @@ const char* kDefaultScene =
     ;
 
 // ---- The program's own keys -----------------------------------------------------------------
+
+// The preview camera that frames the domain read so far (render/preview.hpp's default_camera), for
+// output.preview.width / height pictures.
+struct DefaultView {
+    Vec3 eye, target;
+};
+DefaultView default_view(const ResolvedKeys& r) {
+    const ParamValue *lo = r.find("domain.min"), *hi = r.find("domain.max");
+    const double width = r.number("output.preview.width"), height = r.number("output.preview.height");
+    if (!lo || !hi || !(height > 0)) return {Vec3{0, 0, 1}, Vec3{0, 0, 0}};
+    const PreviewCamera c = default_camera({lo->vector[0], lo->vector[1], lo->vector[2]},
+                                           {hi->vector[0], hi->vector[1], hi->vector[2]}, width / height);
+    const auto vec = [](const PreviewVec& v) { return Vec3{Real(v[0]), Real(v[1]), Real(v[2])}; };
+    return {vec(c.eye), vec(c.target)};
+}
 
 const ParamTable<Scene>& scene_keys() {
     using T = Scene;
@@ -64,10 +80,31 @@ const ParamTable<Scene>& scene_keys() {
                                   "simulated time to reach when neither --steps nor --time is given"));
         t.push_back(number_key<T>("output", "fps", member(&T::fps), ParamRange{0, 10000, true, false}, "1/s",
                                   "frames per simulated second, plus frame 0"));
-        t.push_back(text_list_key<T>("output", "formats", member(&T::formats), {"vtu", "surface"},
-                                     "what each frame writes: particles (vtu), the fluid's surface mesh (surface)"));
+        t.push_back(text_list_key<T>("output", "formats", member(&T::formats), {"vtu", "ply", "surface", "vdb", "preview"},
+                                     "what each frame writes: particles (vtu, ply), the fluid's surface mesh (surface; "
+                                     "as PLY too with ply), its level set and colour field (vdb), a picture (preview)"));
         t.push_back(number_key<T>("output.surface", "voxel", member(&T::surface_voxel), ParamRange{0.1, 4, false, false},
                                   "r0", "the surface field's node spacing"));
+        t.push_back(integer_key<T>("output.preview", "width", [](auto& s) -> auto& { return s.preview.width; }, 16,
+                                   8192, "the preview pictures' width, pixels"));
+        t.push_back(integer_key<T>("output.preview", "height", [](auto& s) -> auto& { return s.preview.height; }, 16,
+                                   8192, "their height, pixels"));
+        t.push_back(choice_key<T, PreviewField>("output.preview", "field", [](auto& s) -> auto& { return s.preview.field; },
+                                                {{"speed", PreviewField::kSpeed},
+                                                 {"pressure", PreviewField::kPressure},
+                                                 {"density", PreviewField::kDensity},
+                                                 {"temperature", PreviewField::kTemperature}},
+                                                "what colours the fluid particles (temperature: with heat.enabled)"));
+        t.push_back(vector_key<T>("output.preview", "eye", [](auto& s) -> auto& { return s.preview.eye; },
+                                  ParamRange::any(), "m", "where the camera stands")
+                        .derive_default([](const ResolvedKeys& r) { return ParamValue::of(default_view(r).eye); },
+                                        "a three-quarter view from above and in front that frames the domain"));
+        t.push_back(vector_key<T>("output.preview", "target", [](auto& s) -> auto& { return s.preview.target; },
+                                  ParamRange::any(), "m", "the point it looks at (differs from eye)")
+                        .derive_default([](const ResolvedKeys& r) { return ParamValue::of(default_view(r).target); },
+                                        "the domain's middle, as framed"));
+        t.push_back(number_key<T>("output.preview", "fov", [](auto& s) -> auto& { return s.preview.fov; },
+                                  ParamRange{1, 170, false, false}, "degrees", "the vertical field of view"));
         return t;
     }();
     return table;
@@ -376,16 +413,18 @@ void read_emitters(Section& root, Scene& scene) {
 
 void read_output(Section s, Scene& scene) {
     s.read(scene_keys(), scene);
-    Section surface = s.object("surface");
-    surface.read(scene_keys(), scene);
-    surface.finish();
+    for (const char* part : {"surface", "preview"}) {
+        Section sub = s.object(part);
+        sub.read(scene_keys(), scene);
+        sub.finish();
+    }
     s.finish();
 }
 
 // The surface's node box spans at most the domain and one support radius around it: a voxel that
 // could need more nodes than a frame may take is refused now.
 void check_surface_voxel(const Scene& scene) {
-    if (!scene.writes_surface()) return;
+    if (!scene.frame_formats().color_field()) return;
     const double nodes = most_surface_nodes(scene.params, Real(scene.surface_voxel) * scene.params.fluid.spacing);
     if (nodes > double(kMaxSurfaceNodes)) {
         char count[32];
@@ -394,6 +433,15 @@ void check_surface_voxel(const Scene& scene) {
                          ": the surface over this domain could need " + count + " nodes, more than " +
                          std::to_string(kMaxSurfaceNodes) + " (2^28); raise it");
     }
+}
+
+// The preview's camera must look somewhere, and temperature colours only what heat conduction gives one.
+void check_preview(const Scene& scene) {
+    const Vec3 d = scene.preview.target - scene.preview.eye;
+    if (!(d.x * d.x + d.y * d.y + d.z * d.z > 0))
+        throw InputError(scene.source + ": output.preview.target must differ from output.preview.eye");
+    if (scene.preview.field == PreviewField::kTemperature && !scene.params.heat.enabled)
+        throw InputError(scene.source + ": output.preview.field \"temperature\" needs heat.enabled true");
 }
 
 // The rows of `table` in `section`.
@@ -436,6 +484,7 @@ std::vector<ParamDoc> scene_schema() {
     add_rows(rows, emitter_keys(), "emitters[]");
     add_rows(rows, scene_keys(), "output");
     add_rows(rows, scene_keys(), "output.surface");
+    add_rows(rows, scene_keys(), "output.preview");
     return rows;
 }
 
@@ -474,9 +523,11 @@ std::string heat_substeps_warning(int needed, int max_substeps) {
     return text;
 }
 
-bool Scene::writes_vtu() const { return std::find(formats.begin(), formats.end(), "vtu") != formats.end(); }
-bool Scene::writes_surface() const {
-    return std::find(formats.begin(), formats.end(), "surface") != formats.end();
+FrameFormats Scene::frame_formats() const {
+    const auto has = [this](const char* name) { return std::find(formats.begin(), formats.end(), name) != formats.end(); };
+    FrameFormats f;
+    f.vtu = has("vtu"), f.ply = has("ply"), f.surface = has("surface"), f.vdb = has("vdb"), f.preview = has("preview");
+    return f;
 }
 
 const char* default_scene_text() { return kDefaultScene; }
@@ -508,6 +559,7 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     read_output(root.object("output"), scene);
     root.finish();
     check_surface_voxel(scene);
+    check_preview(scene);
     scene.resolved = out;
     return scene;
 }

@@ -48,6 +48,26 @@ struct SceneEmitter : EmitterParams {
     std::string name;
 };
 
+// output.formats as flags: what each frame writes (apps/frame_writer.hpp).
+struct FrameFormats {
+    bool vtu = false;      // particles as VTK XML (ParaView)
+    bool ply = false;      // particles, and the surface with "surface", as binary PLY (Blender, Houdini)
+    bool surface = false;  // the fluid's surface mesh as OBJ
+    bool vdb = false;      // the fluid's level set and colour field as OpenVDB grids
+    bool preview = false;  // a PNG picture of the frame
+    bool particles() const { return vtu || ply; }
+    bool color_field() const { return surface || vdb; }  // both start from the colour field
+};
+
+// output.preview: the pictures of output.formats "preview" and `meltwater render` (render/preview.hpp).
+enum class PreviewField { kSpeed, kPressure, kDensity, kTemperature };
+struct PreviewSettings {
+    int width = 960, height = 540;  // pixels
+    PreviewField field = PreviewField::kSpeed;  // what colours the fluid
+    Vec3 eye{0, 0, 0}, target{0, 0, 0};  // the camera (defaults frame the domain)
+    double fov = 35;                     // vertical field of view, degrees (default_camera frames with it)
+};
+
 struct Scene {
     std::string name;
     std::string description;
@@ -75,8 +95,9 @@ struct Scene {
     std::string base_dir;  // folder of the scene file ("" for text scenes): mesh paths are relative to it
     double end_time = 1.0;  // run.end_time, s
     double fps = 30;        // output.fps: frames per simulated second
-    std::vector<std::string> formats{"vtu"};  // "vtu": particles; "surface": the fluid's surface mesh
+    std::vector<std::string> formats{"vtu"};  // output.formats (FrameFormats)
     double surface_voxel = 0.5;  // output.surface.voxel: the surface field's node spacing, in r0
+    PreviewSettings preview;     // output.preview
     SceneJson resolved;  // every key with its value, defaults filled in, overrides applied
 
     bool walls() const { return params.boundary.walls; }
@@ -85,8 +106,9 @@ struct Scene {
     bool has_fluid() const { return !fluid_blocks.empty() || !emitters.empty(); }
     // How far outside the domain faces the walls' first layer goes (sampling/wall_gap.hpp), m.
     Real wall_gap() const;
-    bool writes_vtu() const;
-    bool writes_surface() const;
+    FrameFormats frame_formats() const;
+    bool writes_vtu() const { return frame_formats().vtu; }
+    bool writes_surface() const { return frame_formats().surface; }
     bool writes_frames() const { return !formats.empty(); }
     // A warning for a kernel the scene's support radius makes unstable ("" when there is none):
     // the cubic spline wider than 2.25 r0 (docs/solver.md, "Kernels").

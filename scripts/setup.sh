@@ -6,10 +6,12 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make ninja-build libeigen3-dev libnanoflann-dev libcxxopts-dev doctest-dev
           nlohmann-json3-dev libtinyobjloader-dev libembree-dev libtbb-dev python3-meshio
-          libopenvdb-dev libboost-dev libboost-iostreams-dev strace)
+          libopenvdb-dev libboost-dev libboost-iostreams-dev strace pkg-config libstb-dev
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-openvdb)
 # libboost-dev, libboost-iostreams-dev: OpenVDB's headers include Boost's and its CMake find module
 # asks for Boost.Iostreams, neither of which Debian 12's libopenvdb-dev pulls in. strace: a test
-# watches the program flush its outputs to disk.
+# watches the program flush its outputs to disk. libstb-dev: PNG writing and the pictures' font.
+# pybind11-dev, python3-*: the Python module and its tests; python3-openvdb reads .vdb frames back.
 ./scripts/install_packages.sh "${packages[@]}"
 [[ "${1:-}" == "--packages-only" ]] && exit 0
 

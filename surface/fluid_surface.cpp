@@ -1,4 +1,5 @@
 #include "surface/fluid_surface.hpp"
+#include "surface/color_grid.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -67,17 +68,9 @@ SurfaceNodes surface_nodes_around_fluid(const HostParticles& particles, Vec3 dom
     return nodes;
 }
 
-TriangleMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<Real>& color, double iso, int threads) {
-    TriangleMesh mesh;
-    mesh.source = "the fluid's surface";
-    if (nodes.count() == 0) return mesh;
-    if (color.size() != nodes.count()) throw std::logic_error("mesh_color_field: field and nodes differ in size");
+openvdb::FloatGrid::Ptr color_level_grid(const SurfaceNodes& nodes, const std::vector<Real>& color, double iso) {
     static std::once_flag initialised;
     std::call_once(initialised, [] { openvdb::initialize(); });
-    std::unique_ptr<tbb::global_control> limit;
-    if (threads > 0)
-        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
-
     // A level set's sign: φ = iso - c, negative inside the fluid; nodes with no fluid within a
     // support radius (c = 0) are the background and stay inactive.
     std::vector<float> phi(color.size());
@@ -94,7 +87,19 @@ TriangleMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<Real>
     grid->transform().postTranslate(
         openvdb::Vec3d(double(nodes.origin.x), double(nodes.origin.y), double(nodes.origin.z)));
     openvdb::tools::copyFromDense(dense, *grid, 0.0f);
+    return grid;
+}
 
+TriangleMesh mesh_color_field(const SurfaceNodes& nodes, const std::vector<Real>& color, double iso, int threads) {
+    TriangleMesh mesh;
+    mesh.source = "the fluid's surface";
+    if (nodes.count() == 0) return mesh;
+    if (color.size() != nodes.count()) throw std::logic_error("mesh_color_field: field and nodes differ in size");
+    std::unique_ptr<tbb::global_control> limit;
+    if (threads > 0)
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+
+    const openvdb::FloatGrid::Ptr grid = color_level_grid(nodes, color, iso);
     std::vector<openvdb::Vec3s> points;
     std::vector<openvdb::Vec3I> triangles;
     std::vector<openvdb::Vec4I> quads;
@@ -119,18 +124,29 @@ FluidSurfacer::FluidSurfacer(const SimulationParams& params, double voxel_in_r0,
       spacing_(Real(voxel_in_r0) * params.fluid.spacing),
       threads_(threads) {}
 
+namespace {
+using SurfaceClock = std::chrono::steady_clock;
+double ms_since(SurfaceClock::time_point t) {
+    return std::chrono::duration<double, std::milli>(SurfaceClock::now() - t).count();
+}
+}  // namespace
+
+const FluidSurfacer::Field& FluidSurfacer::field(Simulation& sim, const HostParticles& particles) {
+    const auto start = SurfaceClock::now();
+    field_.nodes = surface_nodes_around_fluid(particles, domain_min_, domain_max_, support_radius_, spacing_);
+    field_.iso = 0;
+    field_.color.clear();
+    if (field_.nodes.count() > 0) sim.fluid_color_field(field_.nodes, field_.color, field_.iso);
+    field_.ms = ms_since(start);
+    return field_;
+}
+
 FluidSurfacer::Surface FluidSurfacer::build(Simulation& sim, const HostParticles& particles) {
-    using clock = std::chrono::steady_clock;
-    const auto ms_since = [](clock::time_point t) {
-        return std::chrono::duration<double, std::milli>(clock::now() - t).count();
-    };
     Surface out;
-    const auto start = clock::now();
-    const SurfaceNodes nodes = surface_nodes_around_fluid(particles, domain_min_, domain_max_, support_radius_, spacing_);
-    double iso = 0;
-    if (nodes.count() > 0) sim.fluid_color_field(nodes, color_, iso);
-    out.field_ms = ms_since(start);
-    out.mesh = mesh_color_field(nodes, color_, iso, threads_);
+    const auto start = SurfaceClock::now();
+    field(sim, particles);
+    out.field_ms = field_.ms;
+    out.mesh = mesh_color_field(field_.nodes, field_.color, field_.iso, threads_);
     out.ms = ms_since(start);
     return out;
 }

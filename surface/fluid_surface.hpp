@@ -43,19 +43,30 @@ class FluidSurfacer {
    public:
     // Nodes `voxel_in_r0` r0 apart (output.surface.voxel); `threads` as for mesh_color_field.
     FluidSurfacer(const SimulationParams& params, double voxel_in_r0, int threads);
+    // The colour field at a frame: its nodes (none without fluid), values and iso-value, and the
+    // milliseconds it took (grid build, field, host copy).
+    struct Field {
+        SurfaceNodes nodes;
+        std::vector<Real> color;
+        double iso = 0;
+        double ms = 0;
+    };
     struct Surface {
         TriangleMesh mesh;
         double ms = 0;        // all of it
-        double field_ms = 0;  // of which the colour field (grid build, field, host copy)
+        double field_ms = 0;  // of which the colour field
     };
-    // `particles`: `sim`'s, as download() gave them at its current time.
+    // `particles`: `sim`'s, as download() gave them at its current time. The field is kept until
+    // the next call (the next frame's reuses its storage); build() computes it too.
+    const Field& field(Simulation& sim, const HostParticles& particles);
     Surface build(Simulation& sim, const HostParticles& particles);
+    const Field& last_field() const { return field_; }
 
    private:
     Vec3 domain_min_, domain_max_;
     Real support_radius_, spacing_;
     int threads_;
-    std::vector<Real> color_;  // kept: the next frame's field reuses it
+    Field field_;
 };
 
 }  // namespace mw

@@ -495,6 +495,40 @@ TEST_CASE("run: two steps write frames, stats.csv and summary.json") {
     for (const auto& entry : fs::directory_iterator(dir)) CHECK(!contains(entry.path().string(), ".tmp"));
 }
 
+TEST_CASE("run: stats.csv follows each moving object's centre; summary.json counts the particles at the end") {
+    // The tiny scene's rigid box (500 kg/m3) starts in the air beside the fluid block, its centre
+    // at y = 0.1 m, and falls.
+    const std::string dir = out_dir("centroid");
+    const Result r = run("run " + tiny_scene_with_box("centroid.json") + " --steps 10 --quiet --out " + dir);
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    std::istringstream csv(slurp(dir + "/stats.csv"));
+    std::string header, first, last, line;
+    std::getline(csv, header);
+    std::getline(csv, first);
+    last = first;
+    while (std::getline(csv, line)) last = line;
+    const auto cell = [&](const std::string& row, const std::string& column) {
+        std::istringstream names(header), values(row);
+        std::string name, value;
+        while (std::getline(names, name, ',') && std::getline(values, value, ','))
+            if (name == column) return std::stod(value);
+        FAIL("no column " << column);
+        return 0.0;
+    };
+    CHECK(cell(first, "centroid_object0_x") == doctest::Approx(0.15).epsilon(1e-3));
+    CHECK(cell(first, "centroid_object0_z") == doctest::Approx(0.1).epsilon(1e-3));
+    const double y0 = cell(first, "centroid_object0_y"), y1 = cell(last, "centroid_object0_y");
+    CHECK(y0 == doctest::Approx(0.1).epsilon(0.01));
+    // Falling freely for 9 steps of 2 ms: g (t1² - t0²) / 2 = 1.6 mm, less what the walls or the
+    // fluid took.
+    CHECK(y1 < y0 - 0.0005);
+    CHECK(y1 > y0 - 0.0025);
+    const auto s = read_json(dir + "/summary.json");
+    CHECK(s["particles_at_end"]["fluid"] == 125);
+    CHECK(s["particles_at_end"]["total"] == s["particles"]["total"]);
+}
+
 TEST_CASE("run: frames every 1/fps of simulated time, none with formats []") {
     const std::string dir = out_dir("cadence");
     // dt 0.002, fps 250: frames at t = 0, 0.004, 0.008 over --time 0.008.
@@ -542,7 +576,7 @@ TEST_CASE("run: plain progress lines when stderr is not a terminal") {
     CHECK(contains(loud.err, "ms/step"));
 }
 
-TEST_CASE("a frame reads back with meshio") {
+TEST_CASE("a frame reads back with meshio, as VTU and as PLY, the walls once in static_boundary.vtu") {
     // Debian's meshio lives under /usr/bin/python3, which another python3 on PATH may hide.
     std::string python;
     for (const char* candidate : {"/usr/bin/python3", "python3"})
@@ -553,22 +587,28 @@ TEST_CASE("a frame reads back with meshio") {
         return;
     }
     const std::string dir = out_dir("meshio");
-    REQUIRE(run("run " + tiny() + " --steps 1 --quiet --out " + dir).code == 0);
+    REQUIRE(run("run " + tiny() + " --steps 1 --quiet --out " + dir + " --set 'output.formats=[\"vtu\",\"ply\"]'").code == 0);
     const std::string script = scratch_dir() + "/read_frame.py";
     write_text(script,
-               "import sys, meshio\n"
-               "m = meshio.read(sys.argv[1])\n"
+               "import sys, meshio, numpy\n"
+               "m = meshio.read(sys.argv[1] + '/particles_00000.vtu')\n"
                "n = len(m.points)\n"
-               "assert n > 125, n\n"
-               "for name in ('velocity', 'density', 'pressure', 'type', 'object'):\n"
+               "for name in ('velocity', 'density', 'pressure', 'type', 'object', 'id'):\n"
                "    assert name in m.point_data, name\n"
                "    assert len(m.point_data[name]) == n, name\n"
                "assert m.point_data['velocity'].shape == (n, 3)\n"
-               "assert (m.point_data['type'].ravel() == 0).sum() == 125\n"
-               "assert set(m.point_data['type'].ravel().tolist()) <= {0, 1, 2, 3, 4}\n"
+               "assert (m.point_data['type'].ravel() == 0).sum() == 125 == n, n\n"
+               "walls = meshio.read(sys.argv[1] + '/static_boundary.vtu')\n"
+               "assert len(walls.points) > 125 and set(walls.point_data['type'].ravel().tolist()) == {1}\n"
+               "ids = numpy.concatenate([m.point_data['id'].ravel(), walls.point_data['id'].ravel()])\n"
+               "assert sorted(ids.tolist()) == list(range(len(ids))), 'id: each particle once'\n"
+               "ply = meshio.read(sys.argv[1] + '/particles_00000.ply')\n"
+               "assert numpy.allclose(ply.points, m.points)\n"
+               "assert numpy.allclose(numpy.stack([ply.point_data['velocity_' + a] for a in 'xyz'], 1), m.point_data['velocity'])\n"
+               "assert (ply.point_data['id'] == m.point_data['id'].ravel()).all()\n"
                "print('ok', n)\n");
     const std::string log = scratch_dir() + "/meshio.log";
-    const int status = std::system((python + " '" + script + "' '" + dir + "/frames/particles_00000.vtu' >'" + log +
+    const int status = std::system((python + " '" + script + "' '" + dir + "/frames' >'" + log +
                                     "' 2>&1")
                                        .c_str());
     CAPTURE(slurp(log));

@@ -1,0 +1,117 @@
+#include "apps/preview_picture.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace mw {
+
+namespace {
+PreviewMesh preview_mesh(const std::vector<std::array<double, 3>>& vertices,
+                         const std::vector<std::array<int, 3>>& triangles) {
+    PreviewMesh m;
+    m.vertices.reserve(vertices.size() * 3);
+    for (const auto& v : vertices)
+        for (double x : v) m.vertices.push_back(float(x));
+    m.triangles.reserve(triangles.size() * 3);
+    for (const auto& t : triangles)
+        for (int index : t) m.triangles.push_back(std::uint32_t(index));
+    return m;
+}
+
+const char* field_title(PreviewField field) {
+    switch (field) {
+        case PreviewField::kSpeed: return "speed, m/s";
+        case PreviewField::kPressure: return "pressure, Pa";
+        case PreviewField::kDensity: return "density, kg/m3";
+        case PreviewField::kTemperature: return "temperature, C";
+    }
+    return "";
+}
+}  // namespace
+
+PreviewMesh solid_preview_mesh(const std::vector<std::array<double, 3>>& vertices,
+                               const std::vector<std::array<int, 3>>& triangles) {
+    PreviewMesh m = preview_mesh(vertices, triangles);
+    m.colour = {176, 150, 120};  // a warm grey apart from the fluid's blues and greens
+    return m;
+}
+
+PreviewMesh surface_preview_mesh(const TriangleMesh& surface) {
+    std::vector<std::array<double, 3>> vertices(surface.vertices.size());
+    for (std::size_t v = 0; v < vertices.size(); ++v)
+        vertices[v] = {surface.vertices[v].x(), surface.vertices[v].y(), surface.vertices[v].z()};
+    PreviewMesh m = preview_mesh(vertices, surface.triangles);
+    // Translucent: the particles inside, coloured by the field, still show through.
+    m.colour = {70, 130, 210};
+    m.opacity = 0.45f;
+    return m;
+}
+
+std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& p) {
+    std::vector<PreviewMesh> meshes;
+    for (const SolidSetup& o : solids) {
+        if (o.melts() || o.triangles.empty()) continue;  // melting: its particles show it; a box: no mesh
+        const bool moving = o.kind != SolidKind::kStatic;
+        std::vector<std::array<double, 3>> vertices(moving ? o.gp.size() : o.rest_vertices.size());
+        for (std::size_t g = 0; g < vertices.size(); ++g) {
+            const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
+            vertices[g] = {double(x.x), double(x.y), double(x.z)};
+        }
+        meshes.push_back(solid_preview_mesh(vertices, o.triangles));
+    }
+    return meshes;
+}
+
+Image preview_picture(const Scene& scene, const HostParticles& p, std::vector<PreviewMesh> meshes, double time,
+                      int index, double speed_scale) {
+    PreviewFrame frame;
+    const std::size_t n = p.position.size();
+    frame.positions.reserve(3 * n);
+    frame.values.reserve(n);
+    frame.kinds.reserve(n);
+    const PreviewField field = scene.preview.field;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 x = p.position[i];
+        frame.positions.insert(frame.positions.end(), {float(x.x), float(x.y), float(x.z)});
+        // Walls' particles are boundary (not drawn); a mesh stands for its object's particles (the
+        // solids' SBPs would poke through it); GPs are the meshes' vertices; pending particles are
+        // not in the scene yet. Static boxes and melting objects have no mesh: their particles show.
+        const std::uint8_t type = p.type[i];
+        const std::int32_t object = p.object[i];
+        const bool meshed = object >= 0 && std::size_t(object) < scene.objects.size() && !scene.objects[object].melts();
+        PreviewKind kind = PreviewKind::hidden;
+        if (type == kFluid) kind = PreviewKind::fluid;
+        else if (type == kStaticBoundary && object < 0) kind = PreviewKind::boundary;
+        else if (type == kStaticBoundary || type == kSurfaceBoundary || type == kInnerBoundary)
+            kind = meshed ? PreviewKind::hidden : PreviewKind::solid;
+        frame.kinds.push_back(kind);
+        double value = 0;
+        switch (field) {
+            case PreviewField::kSpeed: value = double(norm(p.velocity[i])); break;
+            case PreviewField::kPressure: value = double(p.pressure[i]); break;
+            case PreviewField::kDensity: value = double(p.density[i]); break;
+            case PreviewField::kTemperature: value = p.temperature.empty() ? 0.0 : double(p.temperature[i]); break;
+        }
+        frame.values.push_back(float(value));
+    }
+    frame.particle_radius = 0.5 * double(scene.params.fluid.spacing);
+    frame.field_name = field_title(field);
+    if (field == PreviewField::kSpeed && speed_scale > 0) frame.field_range = std::array<double, 2>{0.0, speed_scale};
+    frame.meshes = std::move(meshes);
+    const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
+    frame.domain = std::array<PreviewVec, 2>{PreviewVec{lo.x, lo.y, lo.z}, PreviewVec{hi.x, hi.y, hi.z}};
+    char caption[128];
+    std::snprintf(caption, sizeof caption, "%s  t = %.3f s  frame %d", scene.name.empty() ? "meltwater" : scene.name.c_str(),
+                  time, index);
+    frame.caption = caption;
+    PreviewCamera camera;
+    camera.eye = {scene.preview.eye.x, scene.preview.eye.y, scene.preview.eye.z};
+    camera.target = {scene.preview.target.x, scene.preview.target.y, scene.preview.target.z};
+    camera.fov_y_degrees = scene.preview.fov;
+    PreviewStyle style;
+    style.width = scene.preview.width;
+    style.height = scene.preview.height;
+    return render_preview(frame, camera, style);
+}
+
+}  // namespace mw

@@ -1,0 +1,29 @@
+// A frame as render/preview.hpp draws it, from the program's own data: the particles (as
+// Simulation::download gives them, or as read back from a VTU frame), the solids' meshes and the
+// fluid's surface, with the camera, size and colour field of the scene's output.preview.
+#pragma once
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "apps/scene.hpp"
+#include "render/image.hpp"
+#include "render/preview.hpp"
+#include "sampling/mesh.hpp"
+#include "simulation/simulation.hpp"
+
+namespace mw {
+
+// A mesh for the preview: a solid's (grey, opaque) or the fluid's surface (water blue, translucent).
+PreviewMesh solid_preview_mesh(const std::vector<std::array<double, 3>>& vertices,
+                               const std::vector<std::array<int, 3>>& triangles);
+PreviewMesh surface_preview_mesh(const TriangleMesh& surface);
+// The solids' meshes at this frame (SolidSetup GPs in `particles`; static objects: their rest mesh).
+std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& particles);
+
+// The picture of frame `index` at time `time`. `speed_scale` (m/s): the top of the speed colour
+// bar, the same in every frame of a run (0: the frame's own range).
+Image preview_picture(const Scene& scene, const HostParticles& particles, std::vector<PreviewMesh> meshes, double time,
+                      int index, double speed_scale);
+
+}  // namespace mw
