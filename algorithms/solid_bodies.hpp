@@ -283,23 +283,8 @@ class SolidBodies final : public Module {
     }
     void report(std::vector<double>& values) const override {
         if (object_count_ == 0 || !store_) return;
-        // One thread per object over its IBP slots in order: deterministic. One small copy to
-        // the host, with the report's other sums.
-        const Vec3* position = store_->position.cview().data();
-        const std::uint32_t* store_of_slot = store_of_slot_.view().data();
-        const std::uint32_t* begin = object_ibp_begin_.view().data();
-        const Real* mass = mass_.view().data();
-        Vec3* centroid = object_centroid_.view().data();
-        parallel_for(device_, "solid_object_centroid", object_count_, [=] MW_HD(std::size_t o) {
-            Vec3 first_moment{0, 0, 0};
-            Real total = 0;
-            for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
-                if (store_of_slot[s] == kMeltedSlot) continue;
-                first_moment += mass[s] * position[store_of_slot[s]];
-                total += mass[s];
-            }
-            centroid[o] = total > Real(0) ? first_moment / total : Vec3{0, 0, 0};
-        });
+        // One small copy to the host, with the report's other sums.
+        object_mass_means(store_->position.cview().data(), object_centroid_.view().data(), "solid_object_centroid");
         object_centroid_.download(centroid_host_);
         for (std::size_t o = 0; o < object_count_; ++o)
             if (!moving_names_[o].empty())
@@ -308,25 +293,13 @@ class SolidBodies final : public Module {
     }
 
     // Where PCISPH meets the moving solids this step (pcisph.hpp, SolidLookahead): each soft
-    // object's mean velocity (its momentum over its mass; one thread per object sums its IBPs in
-    // slot order, deterministic), and the way from a store index to its object. The slot map must
+    // object's mean velocity (its momentum over its mass), and the way from a store index to its
+    // object. The slot map must
     // be current.
     SolidLookahead lookahead(const ParticleStore& store, std::size_t solid_end) {
         const Vec3* velocity = store.velocity.cview().data();
-        const std::uint32_t* store_of_slot = store_of_slot_.view().data();
-        const std::uint32_t* begin = object_ibp_begin_.view().data();
-        const Real* mass = mass_.view().data();
         Vec3* mean = object_velocity_.view().data();
-        parallel_for(device_, "solid_object_velocity", object_count_, [=] MW_HD(std::size_t o) {
-            Vec3 momentum{0, 0, 0};
-            Real total = 0;
-            for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
-                if (store_of_slot[s] == kMeltedSlot) continue;
-                momentum += mass[s] * velocity[store_of_slot[s]];
-                total += mass[s];
-            }
-            mean[o] = total > Real(0) ? momentum / total : Vec3{0, 0, 0};
-        });
+        object_mass_means(velocity, mean, "solid_object_velocity");
         SolidLookahead l;
         l.velocity = velocity;
         l.object_velocity = mean;
@@ -552,6 +525,24 @@ class SolidBodies final : public Module {
             t[2] += values[k].z;
         }
         return total;
+    }
+
+    // Per object, the mass-weighted mean of `field` (by store index) over its IBPs that have not
+    // melted (0 for none): one thread per object sums its IBP slots in order, deterministic.
+    void object_mass_means(const Vec3* field, Vec3* mean, const char* kernel_name) const {
+        const std::uint32_t* store_of_slot = store_of_slot_.view().data();
+        const std::uint32_t* begin = object_ibp_begin_.view().data();
+        const Real* mass = mass_.view().data();
+        parallel_for(device_, kernel_name, object_count_, [=] MW_HD(std::size_t o) {
+            Vec3 sum{0, 0, 0};
+            Real total = 0;
+            for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
+                if (store_of_slot[s] == kMeltedSlot) continue;
+                sum += mass[s] * field[store_of_slot[s]];
+                total += mass[s];
+            }
+            mean[o] = total > Real(0) ? sum / total : Vec3{0, 0, 0};
+        });
     }
 
     const DeviceContext& device_;

@@ -261,7 +261,7 @@ void Run::open_outputs() {
     }
     if (resume_) frame_times_ = resume_->frame_times;
     if (scene_.writes_frames()) {
-        frames_ = std::make_unique<FrameWriter>(out_dir_, scene_.frame_formats());
+        frames_ = std::make_unique<FrameWriter>(out_dir_ + "/frames", scene_.frame_formats());
         frames_->set_objects(setup_.solids);
         if (continues_directory_) frames_->keep_earlier(frame_times_);
     }

@@ -94,8 +94,8 @@ bool is_frame_file(const std::string& name) {
            name == std::string(kStaticStem) + ".ply";
 }
 
-FrameWriter::FrameWriter(const std::string& out_dir, const FrameFormats& formats)
-    : frames_dir_(out_dir + "/frames"), formats_(formats) {
+FrameWriter::FrameWriter(const std::string& frames_dir, const FrameFormats& formats)
+    : frames_dir_(frames_dir), formats_(formats) {
     make_directories(frames_dir_);
 }
 

@@ -1,4 +1,5 @@
-// What `meltwater run` writes into OUT/frames/ at each frame (output.formats), each file atomically:
+// What `meltwater run` (and the Python module's frames) write into a frames directory at each
+// frame (output.formats), each file atomically:
 //   particles_NNNNN.vtu / .ply   the particles that move: fluid released so far, solids' SBPs, IBPs
 //                                and GPs, with velocity, density, pressure, type, object, id (the
 //                                particle's index in the scene's list, stable over the run) and
@@ -32,8 +33,8 @@ bool is_frame_file(const std::string& name);
 
 class FrameWriter {
    public:
-    // Creates frames/.
-    FrameWriter(const std::string& out_dir, const FrameFormats& formats);
+    // Creates `frames_dir` (a run's OUT/frames) and its parents.
+    FrameWriter(const std::string& frames_dir, const FrameFormats& formats);
     // The solid objects whose meshes go with every frame (static ones: their rest mesh).
     // A melting object has no mesh to write (its lattice is all of it): its particles show it.
     void set_objects(const std::vector<SolidSetup>& solids) {

@@ -41,6 +41,7 @@ SimulationHandle::SimulationHandle(SceneHandle scene, const std::string& backend
     const SimulationSetup setup = build_setup(s, &carved_fluid_);
     runaway_ = mw::speed_limit(s, setup);
     sim_ = create_simulation(setup, backend_, threads_);
+    solids_ = setup.solids;  // their meshes go with every frame
     stats_ = std::make_unique<StatsTable>(sim_->stage_names(), sim_->last_report().column_names);
     const std::string heat_warning =
         heat_substeps_warning(sim_->heat_substeps_needed(double(s.params.solver.dt)), s.params.heat.max_substeps);
@@ -80,7 +81,8 @@ FrameSeries& SimulationHandle::frames(const std::string& directory) {
     if (!normal.has_filename()) normal = normal.parent_path();
     const std::string key = error ? directory : normal.string();
     auto found = frames_.find(key);
-    if (found == frames_.end()) found = frames_.emplace(key, FrameSeries(directory)).first;
+    if (found == frames_.end())
+        found = frames_.emplace(key, FrameSeries(directory, scene_.scene.frame_formats(), solids_)).first;
     return found->second;
 }
 

@@ -62,6 +62,7 @@ class SimulationHandle {
     std::unique_ptr<StatsTable> stats_;
     Snapshot snapshot_;  // null when the state has changed since the last download
     std::map<std::string, FrameSeries> frames_;  // by the directory's absolute path
+    std::vector<SolidSetup> solids_;             // the setup's objects, whose meshes go with frames
 };
 
 }  // namespace mw::python

@@ -16,12 +16,17 @@ def test_write_frame_numbers_frames_and_lists_them(coarse_scene, tmp_path):
     second = sim.write_frame(str(tmp_path / "frames") + "/")  # the same directory, spelt otherwise
     assert first.endswith("particles_00000.vtu") and second.endswith("particles_00001.vtu")
     pvd = (tmp_path / "frames" / "particles.pvd").read_text()
-    assert re.findall(r'file="([^"]+)"', pvd) == ["particles_00000.vtu", "particles_00001.vtu"]
-    times = [float(t) for t in re.findall(r'timestep="([^"]+)"', pvd)]
+    # Each frame's moving particles as part 0, the static boundary (written once) as part 1.
+    parts = re.findall(r'timestep="([^"]+)" part="(\d)" file="([^"]+)"', pvd)
+    assert [f for _, part, f in parts if part == "0"] == ["particles_00000.vtu", "particles_00001.vtu"]
+    assert {f for _, part, f in parts if part == "1"} == {"static_boundary.vtu"}
+    times = [float(t) for t, part, _ in parts if part == "0"]
     assert times == [0.0, pytest.approx(sim.time)]
     meshio = pytest.importorskip("meshio")
     frame = meshio.read(second)
-    assert len(frame.points) == sim.counts["total"] - sim.counts["pending"]
+    assert len(frame.points) == sim.counts["total"] - sim.counts["pending"] - sim.counts["static_boundary"]
+    walls = meshio.read(tmp_path / "frames" / "static_boundary.vtu")
+    assert len(walls.points) == sim.counts["static_boundary"]
     ids = frame.point_data["id"].ravel()
     assert numpy.allclose(frame.points, sim.position[ids], atol=1e-6)
     assert {"velocity", "density", "pressure", "type", "object", "id"} <= set(frame.point_data)
