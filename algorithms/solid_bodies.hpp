@@ -282,7 +282,10 @@ class SolidBodies final : public Module {
                 for (const char* axis : {"_x", "_y", "_z"}) names.push_back("centroid_" + name + axis);
     }
     void report(std::vector<double>& values) const override {
-        if (object_count_ == 0 || !store_) return;
+        // Static objects only: no column, nothing to compute or copy.
+        if (!store_ || std::all_of(moving_names_.begin(), moving_names_.end(),
+                                   [](const std::string& name) { return name.empty(); }))
+            return;
         // One small copy to the host, with the report's other sums.
         object_mass_means(store_->position.cview().data(), object_centroid_.view().data(), "solid_object_centroid");
         object_centroid_.download(centroid_host_);
@@ -290,6 +293,25 @@ class SolidBodies final : public Module {
             if (!moving_names_[o].empty())
                 values.insert(values.end(), {double(centroid_host_[o].x), double(centroid_host_[o].y),
                                              double(centroid_host_[o].z)});
+    }
+
+    // Per object, the mass-weighted mean of `field` (by store index) over its IBPs that have not
+    // melted (0 for none): one thread per object sums its IBP slots in order, deterministic.
+    // Public: CUDA allows no device lambda in a private member function.
+    void object_mass_means(const Vec3* field, Vec3* mean, const char* kernel_name) const {
+        const std::uint32_t* store_of_slot = store_of_slot_.view().data();
+        const std::uint32_t* begin = object_ibp_begin_.view().data();
+        const Real* mass = mass_.view().data();
+        parallel_for(device_, kernel_name, object_count_, [=] MW_HD(std::size_t o) {
+            Vec3 sum{0, 0, 0};
+            Real total = 0;
+            for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
+                if (store_of_slot[s] == kMeltedSlot) continue;
+                sum += mass[s] * field[store_of_slot[s]];
+                total += mass[s];
+            }
+            mean[o] = total > Real(0) ? sum / total : Vec3{0, 0, 0};
+        });
     }
 
     // Where PCISPH meets the moving solids this step (pcisph.hpp, SolidLookahead): each soft
@@ -525,24 +547,6 @@ class SolidBodies final : public Module {
             t[2] += values[k].z;
         }
         return total;
-    }
-
-    // Per object, the mass-weighted mean of `field` (by store index) over its IBPs that have not
-    // melted (0 for none): one thread per object sums its IBP slots in order, deterministic.
-    void object_mass_means(const Vec3* field, Vec3* mean, const char* kernel_name) const {
-        const std::uint32_t* store_of_slot = store_of_slot_.view().data();
-        const std::uint32_t* begin = object_ibp_begin_.view().data();
-        const Real* mass = mass_.view().data();
-        parallel_for(device_, kernel_name, object_count_, [=] MW_HD(std::size_t o) {
-            Vec3 sum{0, 0, 0};
-            Real total = 0;
-            for (std::uint32_t s = begin[o]; s < begin[o + 1]; ++s) {
-                if (store_of_slot[s] == kMeltedSlot) continue;
-                sum += mass[s] * field[store_of_slot[s]];
-                total += mass[s];
-            }
-            mean[o] = total > Real(0) ? sum / total : Vec3{0, 0, 0};
-        });
     }
 
     const DeviceContext& device_;
