@@ -495,7 +495,7 @@ TEST_CASE("run: two steps write frames, stats.csv and summary.json") {
     for (const auto& entry : fs::directory_iterator(dir)) CHECK(!contains(entry.path().string(), ".tmp"));
 }
 
-TEST_CASE("run: stats.csv follows each moving object's centre; summary.json counts the particles at the end") {
+TEST_CASE("run: stats.csv follows each moving object's centre, and summary.json counts the particles at the end") {
     // The tiny scene's rigid box (500 kg/m3) starts in the air beside the fluid block, its centre
     // at y = 0.1 m, and falls.
     const std::string dir = out_dir("centroid");

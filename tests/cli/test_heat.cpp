@@ -51,7 +51,8 @@ TEST_CASE("run: frames carry each particle's temperature when heat conduction is
     CHECK(contains(slurp(hot + "/frames/particles_00000.vtu"), "Name=\"temperature\""));
     const std::string header = slurp(hot + "/stats.csv").substr(0, 400);
     CHECK(contains(header, "ms_heat"));
-    CHECK(contains(header, "unconverged,heat_substeps,heat_content,solid_max_speed,solid_kinetic_energy,ms_"));
+    CHECK(contains(header, "unconverged,centroid_object0_x,centroid_object0_y,centroid_object0_z,heat_substeps,"
+                           "heat_content,solid_max_speed,solid_kinetic_energy,ms_"));
     const nlohmann::json summary = read_json(hot + "/summary.json");
     REQUIRE(summary.contains("heat_content"));
     CHECK(std::fabs(summary["heat_content"]["relative_change"].get<double>()) < 1e-5);
