@@ -18,6 +18,7 @@
 #include "apps/frame_writer.hpp"
 #include "apps/preview_picture.hpp"
 #include "apps/scene_json.hpp"
+#include "apps/speed_limit.hpp"
 #include "apps/vtu_reader.hpp"
 #include "common/errors.hpp"
 #include "sampling/obj_loader.hpp"
@@ -113,14 +114,9 @@ std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number)
 // The top of the speed colour bar, the same for every frame: a fall through the domain plus the
 // fastest particle of the first frame (the run's own scale, speed_limit.hpp, from what is on disk).
 double speed_scale(const Scene& scene, const HostParticles& first) {
-    const Vec3 g = scene.params.gravity, extent = scene.params.domain_max - scene.params.domain_min;
-    const double g_norm = double(norm(g));
-    const double along = g_norm > 0 ? (std::fabs(double(g.x)) * extent.x + std::fabs(double(g.y)) * extent.y +
-                                       std::fabs(double(g.z)) * extent.z) / g_norm
-                                    : 0.0;
     double start = 0;
     for (const Vec3& v : first.velocity) start = std::max(start, double(norm(v)));
-    return std::sqrt(2 * g_norm * along) + start;
+    return fall_speed(scene) + start;
 }
 
 cxxopts::Options render_options() {

@@ -198,17 +198,21 @@ std::string FrameWriter::write_preview(int index, const Image& picture) const {
     return path;
 }
 
+std::vector<std::array<double, 3>> object_vertices(const SolidSetup& o, const HostParticles& p) {
+    const bool moving = o.kind != SolidKind::kStatic;
+    std::vector<std::array<double, 3>> vertices(moving ? o.gp.size() : o.rest_vertices.size());
+    for (std::size_t g = 0; g < vertices.size(); ++g) {
+        const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
+        vertices[g] = {double(x.x), double(x.y), double(x.z)};
+    }
+    return vertices;
+}
+
 void FrameWriter::write_objects(int index, const HostParticles& p) const {
     for (const SolidSetup& o : objects_) {
         if (o.triangles.empty()) continue;  // a static box: no mesh
-        const bool moving = o.kind != SolidKind::kStatic;
-        std::vector<std::array<double, 3>> vertices(moving ? o.gp.size() : o.rest_vertices.size());
-        for (std::size_t g = 0; g < vertices.size(); ++g) {
-            const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
-            vertices[g] = {double(x.x), double(x.y), double(x.z)};
-        }
         write_obj(frames_dir_ + "/object_" + o.name + numbered("_", index, ".obj"),
-                  "meltwater object " + o.name + ", frame " + std::to_string(index), vertices, o.triangles);
+                  "meltwater object " + o.name + ", frame " + std::to_string(index), object_vertices(o, p), o.triangles);
     }
 }
 

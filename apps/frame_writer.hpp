@@ -12,6 +12,7 @@
 //   fluid_NNNNN.vdb              the fluid as OpenVDB grids ("vdb"; surface/fluid_grids.hpp)
 //   preview_NNNNN.png            a picture of the frame ("preview"; render/preview.hpp)
 #pragma once
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +31,10 @@ int frame_file_number(const std::string& name);
 // Whether `name` is a file a run writes in frames/: a numbered one, the static boundary's or
 // particles.pvd.
 bool is_frame_file(const std::string& name);
+
+// A solid object's mesh vertices at this frame: a moving object's GPs in `particles` (scene
+// order), a static object's rest mesh.
+std::vector<std::array<double, 3>> object_vertices(const SolidSetup& object, const HostParticles& particles);
 
 class FrameWriter {
    public:

@@ -1,5 +1,7 @@
 #include "apps/preview_picture.hpp"
 
+#include "apps/frame_writer.hpp"
+
 #include <cmath>
 #include <cstdio>
 
@@ -51,13 +53,7 @@ std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& so
     std::vector<PreviewMesh> meshes;
     for (const SolidSetup& o : solids) {
         if (o.melts() || o.triangles.empty()) continue;  // melting: its particles show it; a box: no mesh
-        const bool moving = o.kind != SolidKind::kStatic;
-        std::vector<std::array<double, 3>> vertices(moving ? o.gp.size() : o.rest_vertices.size());
-        for (std::size_t g = 0; g < vertices.size(); ++g) {
-            const Vec3 x = moving ? p.position[o.gp[g]] : o.rest_vertices[g];
-            vertices[g] = {double(x.x), double(x.y), double(x.z)};
-        }
-        meshes.push_back(solid_preview_mesh(vertices, o.triangles));
+        meshes.push_back(solid_preview_mesh(object_vertices(o, p), o.triangles));
     }
     return meshes;
 }

@@ -26,6 +26,10 @@ struct SpeedLimit {
 
 SpeedLimit speed_limit(const Scene& scene, const SimulationSetup& setup);
 
+// sqrt(2 |g| L), L the domain's extent along gravity (0 without gravity), m/s: a fall through
+// the whole domain.
+double fall_speed(const Scene& scene);
+
 // The limit and where it came from, as `info` and the run's stop message say it:
 // "solver.max_speed 74.12 m/s (20 times the scene's 3.71 m/s: ...)", or "solver.max_speed 50 m/s".
 std::string describe(const SpeedLimit& limit);
