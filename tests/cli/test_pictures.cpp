@@ -95,7 +95,7 @@ TEST_CASE("render: a finished run's frames drawn again are the pictures the run 
     CHECK(!fs::exists(dir + "/pressure/preview_00001.png"));
 }
 
-TEST_CASE("bad input: preview keys and render's RUN_DIR and options") {
+TEST_CASE("bad input: preview keys, info's --time-steps, and render's RUN_DIR and options") {
     const std::string scene = box_scene();
     check_rejected(run("info " + scene + " --set output.preview.width=8"), {"output.preview.width"});
     check_rejected(run("info " + scene + " --set output.preview.field=\\\"colour\\\""), {"output.preview.field"});
@@ -103,6 +103,8 @@ TEST_CASE("bad input: preview keys and render's RUN_DIR and options") {
                    {"output.preview.field", "heat.enabled"});
     check_rejected(run("info " + scene + " --set 'output.preview.eye=[1,1,1]' --set 'output.preview.target=[1,1,1]'"),
                    {"output.preview.target", "output.preview.eye"});
+    check_rejected(run("info " + scene + " --time-steps -1"), {"--time-steps"});
+    check_rejected(run("info " + scene + " --time-steps 1001"), {"--time-steps"});
     check_rejected(run("render"), {"RUN_DIR"});
     check_rejected(run("render " + scratch_dir() + "/no_such_run"), {"no_such_run", "not a directory"});
     const std::string empty = out_dir("pictures_empty");
