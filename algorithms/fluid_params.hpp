@@ -28,6 +28,11 @@ struct SolverParams {
     Real eta_max = 0;
     int min_iterations = 3;
     int max_iterations = 100;
+    // The longest step an elastic object's shape matching takes, s; 0: one per step (the paper's).
+    // LSM's pull toward the goal is α (g - x)/Δt, so a body's sag under a load grows as Δt²: with
+    // a positive value a longer step runs the solids in equal substeps no longer than it, and the
+    // sag no longer depends on the step (solid_bodies.hpp, docs/lsm.md).
+    Real solid_substep = 0;
 };
 
 // The scenes' peak bound: 5 eta (5% at the default eta of 1%), off when that is 1 or more. On the
@@ -97,6 +102,9 @@ inline const ParamTable<SolverParams>& solver_keys() {
                                    "PCISPH iterations at least"));
         t.push_back(integer_key<T>("solver", "max_iterations", member(&T::max_iterations), 1, 10000,
                                    "PCISPH iterations at most (and at least min_iterations)"));
+        t.push_back(number_key<T>("solver", "solid_substep", member(&T::solid_substep), ParamRange{0, 1, false, false},
+                                  "s", "elastic objects' shape matching runs in substeps no longer than this (a pinned body's sag "
+                                  "then does not depend on the step); 0: one per step (docs/lsm.md)"));
         return t;
     }();
     return table;

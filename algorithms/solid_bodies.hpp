@@ -9,6 +9,7 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
@@ -104,7 +105,11 @@ class SolidBodies final : public Module {
         }
         objects_.upload(L.objects);
         has_rigid_ = false;
-        for (const auto& o : L.objects) has_rigid_ = has_rigid_ || o.rigid;
+        has_elastic_ = false;
+        for (const auto& o : L.objects) {
+            has_rigid_ = has_rigid_ || o.rigid;
+            has_elastic_ = has_elastic_ || !o.rigid;
+        }
         wall_impulse_.assign(has_rigid_ ? ibp_count_ : 0, Vec3{0, 0, 0});
         gp_rest_.upload(L.gp_rest);
         gp_offsets_.upload(L.gp_offsets);
@@ -235,10 +240,11 @@ class SolidBodies final : public Module {
 
     // The module's stages, over `store` (init's): where PCISPH meets the solids (`predicted`:
     // where the step will take them, coupling.predict_solids; otherwise where they start it), and
-    // one LSM step under `gravity` inside the domain box. The slot map must be current (the
-    // simulation rebuilds it after every sort).
-    void plan(ParticleStore& store, Vec3 gravity, Vec3 domain_min, Vec3 domain_max, bool predicted) {
+    // one LSM step under `gravity` inside the domain box, in substeps no longer than `substep`.
+    // The slot map must be current (the simulation rebuilds it after every sort).
+    void plan(ParticleStore& store, Vec3 gravity, Vec3 domain_min, Vec3 domain_max, bool predicted, Real substep) {
         store_ = &store;
+        substep_ = substep;
         gravity_ = gravity;
         domain_min_ = domain_min;
         domain_max_ = domain_max;
@@ -257,17 +263,28 @@ class SolidBodies final : public Module {
         if (active()) summary(*store_);
     }
 
-    // One LSM step (the slot map must be current): regions, IBP update, GPs, SBPs.
+    // LSM substeps in a step of dt: one without an elastic object (a rigid fit does not sag) or
+    // without solver.solid_substep, else the fewest no longer than it.
+    int substeps(Real dt) const {
+        if (!has_elastic_ || !(substep_ > Real(0)) || dt <= substep_) return 1;
+        return int(std::ceil(double(dt) / double(substep_) * (1 - 1e-6)));
+    }
+
+    // One LSM step (the slot map must be current): regions and IBP update in substeps
+    // (substeps()), then GPs and SBPs once.
     SolidSummary step(ParticleStore& store, Real dt, Vec3 gravity, Vec3 domain_min, Vec3 domain_max) {
         const LsmData d = data(store);
-        lsm_region_update(device_, d);
         LsmStepParams p;
-        p.dt = dt;
+        p.dt = dt / Real(substeps(dt));
         p.gravity = gravity;
         p.domain_min = domain_min;
         p.domain_max = domain_max;
-        lsm_particle_update(device_, d, p);
-        if (has_rigid_) lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_, wall_impulse_.view().data());
+        // The fluid's forces (a_ext) hold over the whole step: substeps apply the same impulse.
+        for (int k = substeps(dt); k > 0; --k) {
+            lsm_region_update(device_, d);
+            lsm_particle_update(device_, d, p);
+            if (has_rigid_) lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_, wall_impulse_.view().data());
+        }
         const InterpolationData g = interpolation(store);
         interpolate_geometry(device_, g, dt);
         interpolate_surface(device_, g);
@@ -555,6 +572,8 @@ class SolidBodies final : public Module {
     bool predicts_ = false;
     std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0, object_count_ = 0;
     bool has_rigid_ = false;  // any rigid object (lsm_rigid_walls)
+    bool has_elastic_ = false;  // any elastic object (substeps())
+    Real substep_ = 0;          // solver.solid_substep
     DeviceArray<Vec3> wall_impulse_;  // per IBP of a rigid object, its walls' impulses this step
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;

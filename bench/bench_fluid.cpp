@@ -17,6 +17,9 @@
 //   7. Coupling with moving solids: scenes/floating_boxes.json (two rigid boxes and an elastic
 //      cube settling in a pool) run two-way, with and without the velocity–position correction
 //      against them: steps, ms per step, the coupling stages' share, top speed.
+//   7b. The extremes: scenes/thrown_cube.json (a 0.12 m cube thrown down at 5 m/s into a pool)
+//      rigid and elastic, at 100, 500, 2,000 and 10,000 kg/m³, at CFL 0.4 and at CFL 1 under
+//      30 ms: whether it runs to the end, steps, time, and how the cube ends.
 //   8. Heat conduction: scenes/warm_jelly.json (a warm elastic cube and a warm rigid block in cold
 //      water) without heat, and with it at its diffusivities and at 5 and 25 times them: steps,
 //      ms per step, the heat stage's median and its sub-steps.
@@ -42,6 +45,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/scene.hpp"
 #include "apps/scene_builder.hpp"
+#include "apps/speed_limit.hpp"
 #include "simulation/factory.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/wall_gap.hpp"
@@ -58,7 +62,7 @@ struct Options {
     bool quick = false;
     std::string out;
     // The report's sections to run (--sections, comma-separated): all by default.
-    std::vector<std::string> sections{"dams", "splish", "variants", "kernels", "steps", "objects", "coupling", "heat", "melting", "paper"};
+    std::vector<std::string> sections{"dams", "splish", "variants", "kernels", "steps", "objects", "coupling", "extremes", "heat", "melting", "paper"};
     bool wants(const std::string& section) const {
         return std::find(sections.begin(), sections.end(), section) != sections.end();
     }
@@ -308,21 +312,21 @@ int main(int argc, char** argv) {
             std::stringstream list(argv[++i]);
             for (std::string name; std::getline(list, name, ',');) {
                 if (!Options{}.wants(name)) {  // the default holds every section
-                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels, steps, objects, coupling, heat, melting, paper)\n",
+                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels, steps, objects, coupling, extremes, heat, melting, paper)\n",
                                  name.c_str());
                     return 2;
                 }
                 chosen.push_back(name);
             }
             if (chosen.empty()) {
-                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels, steps, objects, coupling, heat, melting, paper\n");
+                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels, steps, objects, coupling, extremes, heat, melting, paper\n");
                 return 2;
             }
             o.sections = chosen;
         } else {
             std::fprintf(stderr,
                          "usage: bench_fluid [--backend openmp|cuda] [--threads N] [--large] [--quick] "
-                         "[--sections dams,splish,variants,kernels,steps,objects,coupling,heat,melting,paper] [--out FILE]\n");
+                         "[--sections dams,splish,variants,kernels,steps,objects,coupling,extremes,heat,melting,paper] [--out FILE]\n");
             return 2;
         }
     }
@@ -570,6 +574,60 @@ int main(int argc, char** argv) {
               << rows;
             emit(t.str() + "\nThe paper's Table 2 gives 5.3 ms of coupling per step for its Fig. 8 (25k fluid "
                            "particles, 3.5k SBPs, 6k IBPs) on a GTX 690.\n\n");
+        }
+        // The extremes (scenes/thrown_cube.json): Table 1's range of solid densities thrown into
+        // a pool, each run to its end or to the guard that stops it (docs/solver.md, "Guards").
+        if (o.wants("extremes")) {
+            const double end_time = o.quick ? 0.6 : 1.5;
+            std::string rows;
+            long fluid = 0;
+            for (const char* kind : {"rigid", "elastic"})
+                for (const char* density : {"100", "500", "2000", "10000"})
+                    for (const char* cfl : {"0.4", "1"}) {
+                        const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/thrown_cube.json",
+                                                       {std::string("objects.0.kind=\"") + kind + "\"",
+                                                        std::string("objects.0.density=") + density,
+                                                        std::string("solver.cfl_number=") + cfl});
+                        const SimulationSetup setup = build_setup(scene);
+                        const double limit = speed_limit(scene, setup).limit;
+                        auto sim = make(o, setup);
+                        fluid = sim->counts().by_type[kFluid];
+                        long steps = 0;
+                        double ms = 0, top_fluid = 0;
+                        std::string ended = "ran";
+                        try {
+                            while (sim->time() < end_time) {
+                                sim->step();
+                                const StepReport& rep = sim->last_report();
+                                ++steps;
+                                ms += rep.total_ms;
+                                top_fluid = std::max(top_fluid, rep.max_speed);
+                                if (!(rep.max_speed < limit) || !(rep.solid_max_speed < limit)) {
+                                    char at[64];
+                                    std::snprintf(at, sizeof at, "runaway at %.3f s", sim->time());
+                                    ended = at;
+                                    break;
+                                }
+                            }
+                        } catch (const std::exception& e) {
+                            ended = std::string("stopped: ") + e.what();
+                        }
+                        const StepReport& last = sim->last_report();
+                        const double centre = last.has("centroid_cube_y") ? last.value("centroid_cube_y") : 0.0;
+                        char cell[400];
+                        std::snprintf(cell, sizeof cell, "| %s | %s | %s | %s | %ld | %.2f | %.2f | %.3f | %.3f |\n", kind,
+                                      density, cfl, ended.c_str(), steps, ms / 1000, top_fluid, last.solid_max_speed, centre);
+                        rows += cell;
+                        std::fprintf(stderr, "  extremes %-8s %6s kg/m3 CFL %-4s %s, %ld steps\n", kind, density, cfl,
+                                     ended.c_str(), steps);
+                    }
+            std::ostringstream t;
+            t << "### The extremes (scenes/thrown_cube.json: " << fluid << " fluid particles, a 0.12 m cube thrown down "
+              << "at 5 m/s, steps up to 30 ms; to t = " << end_time << " s)\n\n"
+              << "| kind | kg/m3 | CFL | end | steps | s | top fluid speed m/s | fastest IBP at the end m/s | cube's "
+                 "centre height at the end m |\n|---|---|---|---|---|---|---|---|---|\n"
+              << rows;
+            emit(t.str() + "\nOn the floor the cube's centre is at 0.06 m; floating, 0.25 m less its draft plus 0.06 m.\n\n");
         }
         // Heat conduction (scenes/warm_jelly.json): the stage's cost against the step's, as the
         // Fourier number, and with it the explicit sub-steps (algorithms/heat.hpp), grows.

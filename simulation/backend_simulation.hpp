@@ -239,7 +239,8 @@ void BackendSimulation<Kernel>::build_modules(const SimulationSetup& setup, cons
     NeighborSearch<Kernel>& search = add<NeighborSearch<Kernel>>(state_, lo, hi, arriving);
     SolidBodies& solids = add<SolidBodies>(device_);
     solids.init(setup, order, store);
-    solids.plan(store, params_.gravity, params_.domain_min, params_.domain_max, has_fluid && params_.coupling.predict_solids);
+    solids.plan(store, params_.gravity, params_.domain_min, params_.domain_max, has_fluid && params_.coupling.predict_solids,
+                params_.solver.solid_substep);
     search.on_sorted([&solids, &store] {
         if (solids.active()) solids.update_slot_map(store);  // slot -> store index after the sort
     });

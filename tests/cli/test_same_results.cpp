@@ -85,7 +85,7 @@ TEST_CASE("same results: the fluid-only scenes") {
 }
 
 TEST_CASE("same results: scenes with solids, heat and melting") {
-    for (const char* name : {"cantilever", "floating_boxes", "hanging_film", "melting_ice", "warm_jelly"}) {
+    for (const char* name : {"cantilever", "floating_boxes", "hanging_film", "melting_ice", "thrown_cube", "warm_jelly"}) {
         CAPTURE(name);
         check_scene(name);
     }

@@ -177,6 +177,7 @@ TEST_CASE("bad scenes give one line naming the key") {
         {"wrong type (bool)", tiny, {"boundary.walls=3"}, {"boundary.walls", "true or false"}},
         {"eta out of range", tiny, {"solver.eta=1.5"}, {"solver.eta", "(0, 1)", "1.5"}},
         {"negative viscosity", tiny, {"fluid.viscosity=-1"}, {"fluid.viscosity", ">= 0"}},
+        {"negative solid substep", tiny, {"solver.solid_substep=-0.001"}, {"solver.solid_substep", "[0, 1]", "-0.001"}},
         {"support radius too small", tiny, {"fluid.support_radius=0.01"}, {"fluid.support_radius", "(0.02, 0.08]"}},
         {"support radius too large", tiny, {"fluid.support_radius=0.2"}, {"fluid.support_radius"}},
         {"non-integer", tiny, {"boundary.layers=1.5"}, {"boundary.layers", "integer"}},

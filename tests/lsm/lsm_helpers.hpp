@@ -100,8 +100,11 @@ struct Cantilever {
     double amplitude = 0;   // half of max - min of the tip height
     bool finite = true;
 };
-inline Cantilever run_cantilever(int w, Real alpha, Real dt, double seconds, Vec3 size = Vec3{0.3f, 0.1f, 0.1f}) {
+// `substep`: solver.solid_substep; negative keeps the default.
+inline Cantilever run_cantilever(int w, Real alpha, Real dt, double seconds, Vec3 size = Vec3{0.3f, 0.1f, 0.1f},
+                                 Real substep = -1) {
     SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 0.4f}, dt, Vec3{0, -9.81f, 0});
+    if (substep >= 0) s.params.solver.solid_substep = substep;
     const Vec3 c{Real(0.1) + size.x / 2, Real(0.7), Real(0.2)};
     const Real clamp_x = Real(0.1) + Real(0.04);
     add(s, box_mesh(size, c), solid(SolidKind::kElastic, 1000, w, alpha), Vec3{0, 0, 0},
