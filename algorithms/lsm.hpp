@@ -288,6 +288,42 @@ inline void lsm_particle_update(const DeviceContext& device, const LsmData d, co
     });
 }
 
+// A body's IBPs summed relative to an anchor IBP (so that float keeps the body's size, not its
+// place): mass, first moment, momentum, moment of momentum and inertia Σ m (|r|² E - r rᵀ).
+struct BodySums {
+    Real M = 0;
+    Vec3 first_moment{0, 0, 0}, momentum{0, 0, 0}, moment_of_momentum{0, 0, 0};
+    Real ixx = 0, iyy = 0, izz = 0, ixy = 0, ixz = 0, iyz = 0;
+    MW_INLINE void add(Real m, Vec3 r, Vec3 v) {
+        M += m;
+        first_moment += m * r;
+        momentum += m * v;
+        moment_of_momentum += m * cross(r, v);
+        ixx += m * (r.y * r.y + r.z * r.z), iyy += m * (r.x * r.x + r.z * r.z), izz += m * (r.x * r.x + r.y * r.y);
+        ixy -= m * r.x * r.y, ixz -= m * r.x * r.z, iyz -= m * r.y * r.z;
+    }
+};
+
+// The body's rigid motion: its centre c (from the anchor), velocity V and spin ω = I⁻¹ L about c
+// (parallel axis theorem: I_c = I_anchor - M (|c|² E - c cᵀ), L_c = L_anchor - c × P). M > 0.
+struct BodyMotion {
+    Vec3 centre{0, 0, 0}, velocity{0, 0, 0}, spin{0, 0, 0};
+    SymMat3 inverse_inertia{0, 0, 0, 0, 0, 0};
+};
+MW_INLINE BodyMotion body_motion(const BodySums& b) {
+    BodyMotion m;
+    const Vec3 c = b.first_moment / b.M;
+    m.centre = c;
+    m.velocity = b.momentum / b.M;
+    const Vec3 L = b.moment_of_momentum - cross(c, b.momentum);
+    m.inverse_inertia = lsm_detail::regularised_inverse(
+        double(b.ixx - b.M * (c.y * c.y + c.z * c.z)), double(b.iyy - b.M * (c.x * c.x + c.z * c.z)),
+        double(b.izz - b.M * (c.x * c.x + c.y * c.y)), double(b.ixy + b.M * c.x * c.y), double(b.ixz + b.M * c.x * c.z),
+        double(b.iyz + b.M * c.y * c.z));
+    m.spin = m.inverse_inertia * L;
+    return m;
+}
+
 // Sweeps over a rigid object's contacts with the walls (lsm_rigid_walls).
 constexpr int kRigidWallSweeps = 8;
 
@@ -320,9 +356,7 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
         Real depth[6] = {0, 0, 0, 0, 0, 0};
         Vec3 anchor{0, 0, 0};
         bool anchored = false, touching = false;
-        Real M = 0;
-        Vec3 first_moment{0, 0, 0}, momentum{0, 0, 0}, moment_of_momentum{0, 0, 0};
-        Real ixx = 0, iyy = 0, izz = 0, ixy = 0, ixz = 0, iyz = 0;  // Σ m (|r|² E - r rᵀ) about the anchor
+        BodySums body;
         for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {
             const std::uint32_t i = d.store_of_slot[s];
             if (i == kMeltedSlot) continue;
@@ -336,26 +370,14 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
                 if (above > depth[2 * a + 1]) depth[2 * a + 1] = above;
                 touching = touching || below > Real(0) || above > Real(0);
             }
-            const Real m = d.mass[s];
-            const Vec3 v = d.velocity[i];
-            M += m;
-            first_moment += m * r;
-            momentum += m * v;
-            moment_of_momentum += m * cross(r, v);
-            ixx += m * (r.y * r.y + r.z * r.z), iyy += m * (r.x * r.x + r.z * r.z), izz += m * (r.x * r.x + r.y * r.y);
-            ixy -= m * r.x * r.y, ixz -= m * r.x * r.z, iyz -= m * r.y * r.z;
+            body.add(d.mass[s], r, d.velocity[i]);
         }
-        if (!touching || !(M > Real(0)) || !is_finite(momentum)) return;  // non-finite values are the guard's
-        // The body's centre c (from the anchor), velocity V and spin ω = I⁻¹ L about c (parallel
-        // axis theorem: I_c = I_anchor - M (|c|² E - c cᵀ), L_c = L_anchor - c × P).
-        const Vec3 c = first_moment / M;
-        Vec3 V = momentum / M;
-        const Vec3 L = moment_of_momentum - cross(c, momentum);
-        const SymMat3 inverse_inertia = lsm_detail::regularised_inverse(
-            double(ixx - M * (c.y * c.y + c.z * c.z)), double(iyy - M * (c.x * c.x + c.z * c.z)),
-            double(izz - M * (c.x * c.x + c.y * c.y)), double(ixy + M * c.x * c.y), double(ixz + M * c.x * c.z),
-            double(iyz + M * c.y * c.z));
-        Vec3 omega = inverse_inertia * L;
+        if (!touching || !(body.M > Real(0)) || !is_finite(body.momentum)) return;  // non-finite values are the guard's
+        const BodyMotion motion = body_motion(body);
+        const Real M = body.M;
+        const Vec3 c = motion.centre;
+        const SymMat3 inverse_inertia = motion.inverse_inertia;
+        Vec3 V = motion.velocity, omega = motion.spin;
         // Every IBP past a wall is a contact. Its impulse along the wall's normal n, accumulated
         // over sweeps of the contacts in slot order and never negative (a wall pushes, never
         // pulls), is what takes the body's velocity into the wall there to zero: the velocity at
@@ -401,6 +423,45 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
             d.velocity[i] = V + cross(omega, (x - anchor) - c);
             d.position[i] = x + shift;
         }
+    });
+}
+
+// Whole-body damping (objects[].lsm.body_damping, rate k): every IBP of an elastic object moves
+// its velocity toward the body's rigid motion at its place, V + ω × (x - c), by 1 - e^(-k Δt).
+// Per region (lsm.damping) a bending mode is nearly rigid in each region and is not damped; the
+// whole body's deformation is. Momentum and angular momentum are kept (Σ m (V + ω × r) = M V,
+// Σ m r × (V + ω × r) = I ω = L). A pinned body's rigid motion is none: its velocity decays
+// (toward a rigid fit, a swinging beam would keep the swing the fit turns with). One thread per
+// object sums its IBPs in slot order (deterministic), then one per IBP.
+inline void lsm_body_damping(const DeviceContext& device, const LsmData d, Real dt, const std::uint32_t* object_ibp_begin,
+                             std::size_t object_count, BodyMotion* motion, Vec3* anchor) {
+    parallel_for(device, "lsm_body_motion", object_count, [=] MW_HD(std::size_t o) {
+        const LsmObjectParams obj = d.objects[o];
+        if (obj.rigid || !(obj.body_damping_rate > Real(0))) return;
+        BodySums body;
+        bool anchored = false, pinned = false;
+        Vec3 a{0, 0, 0};
+        for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {
+            const std::uint32_t i = d.store_of_slot[s];
+            if (i == kMeltedSlot) continue;
+            pinned = pinned || d.pinned[s];
+            if (!anchored) a = d.position[i], anchored = true;
+            body.add(d.mass[s], d.position[i] - a, d.velocity[i]);
+        }
+        anchor[o] = a;
+        // A pinned body has no rigid motion to keep: its whole velocity decays.
+        motion[o] = body.M > Real(0) && !pinned ? body_motion(body) : BodyMotion{};
+    });
+    parallel_for(device, "lsm_body_damping", d.ibp_count, [=] MW_HD(std::size_t si) {
+        const std::uint32_t s = static_cast<std::uint32_t>(si);
+        const std::uint32_t i = d.store_of_slot[s];
+        if (i == kMeltedSlot || d.pinned[s]) return;
+        const std::int32_t o = d.object[s];
+        const LsmObjectParams obj = d.objects[o];
+        if (obj.rigid || !(obj.body_damping_rate > Real(0))) return;
+        const BodyMotion m = motion[o];
+        const Vec3 rigid = m.velocity + cross(m.spin, (d.position[i] - anchor[o]) - m.centre);
+        d.velocity[i] += (Real(1) - std::exp(-obj.body_damping_rate * dt)) * (rigid - d.velocity[i]);
     });
 }
 

@@ -46,7 +46,8 @@ MW_INLINE Vec3 operator*(const SymMat3& s, Vec3 v) {
 // SimulationSetup::solids).
 struct LsmObjectParams {
     Real alpha = 1;         // stiffness α
-    Real damping_rate = 0;  // 1/s
+    Real damping_rate = 0;  // 1/s, per region (lsm.damping)
+    Real body_damping_rate = 0;  // 1/s, over the whole body (lsm.body_damping)
     Real friction = 0;      // wall friction
     Real margin = 0;        // IBPs stay this far inside the domain walls
     std::uint8_t rigid = 0; // 1 for a rigid object (one region), 0 for an elastic one
@@ -381,6 +382,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         LsmObjectParams& P = L.objects[o];
         P.alpha = s.kind == SolidKind::kRigid ? Real(1) : s.stiffness;
         P.damping_rate = s.damping;
+        P.body_damping_rate = s.kind == SolidKind::kRigid ? Real(0) : s.body_damping;
         P.friction = s.wall_friction;
         P.margin = Real(0.5) * s.spacing;
         P.rigid = s.kind == SolidKind::kRigid ? 1 : 0;

@@ -100,15 +100,17 @@ struct Cantilever {
     double amplitude = 0;   // half of max - min of the tip height
     bool finite = true;
 };
-// `substep`: solver.solid_substep; negative keeps the default.
+// `substep`: solver.solid_substep; negative keeps the default. `tail`: the share of the run at its
+// end that sag and amplitude are taken over (1: all of it).
 inline Cantilever run_cantilever(int w, Real alpha, Real dt, double seconds, Vec3 size = Vec3{0.3f, 0.1f, 0.1f},
-                                 Real substep = -1) {
+                                 Real substep = -1, Real body_damping = 0, double tail = 1) {
     SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 0.4f}, dt, Vec3{0, -9.81f, 0});
     if (substep >= 0) s.params.solver.solid_substep = substep;
     const Vec3 c{Real(0.1) + size.x / 2, Real(0.7), Real(0.2)};
     const Real clamp_x = Real(0.1) + Real(0.04);
-    add(s, box_mesh(size, c), solid(SolidKind::kElastic, 1000, w, alpha), Vec3{0, 0, 0},
-        [clamp_x](const Vec3& x) { return x.x < clamp_x; });
+    SolidSetup body = solid(SolidKind::kElastic, 1000, w, alpha);
+    body.body_damping = body_damping;
+    add(s, box_mesh(size, c), body, Vec3{0, 0, 0}, [clamp_x](const Vec3& x) { return x.x < clamp_x; });
     const std::vector<std::uint32_t> ids = ibps(s);
     std::uint32_t tip = ids[0];
     for (std::uint32_t i : ids)
@@ -127,11 +129,10 @@ inline Cantilever run_cantilever(int w, Real alpha, Real dt, double seconds, Vec
     }
     Cantilever r;
     double lo = 1e30, hi = -1e30, mean = 0;
-    for (double v : y) {
-        r.finite = r.finite && std::isfinite(v);
-        lo = std::min(lo, v), hi = std::max(hi, v), mean += v;
-    }
-    mean /= double(y.size());
+    const std::size_t from = y.size() - std::size_t(std::lround(tail * double(y.size())));
+    for (std::size_t k = 0; k < y.size(); ++k) r.finite = r.finite && std::isfinite(y[k]);
+    for (std::size_t k = from; k < y.size(); ++k) lo = std::min(lo, y[k]), hi = std::max(hi, y[k]), mean += y[k];
+    mean /= double(y.size() - from);
     r.sag = y0 - mean;
     r.amplitude = 0.5 * (hi - lo);
     const double p = period_in_samples(y);
