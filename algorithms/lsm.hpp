@@ -306,8 +306,9 @@ struct BodySums {
 
 // The body's rigid motion: its centre c (from the anchor), velocity V and spin ω = I⁻¹ L about c
 // (parallel axis theorem: I_c = I_anchor - M (|c|² E - c cᵀ), L_c = L_anchor - c × P). M > 0.
+// `anchor` is the caller's to keep with it (lsm_body_damping).
 struct BodyMotion {
-    Vec3 centre{0, 0, 0}, velocity{0, 0, 0}, spin{0, 0, 0};
+    Vec3 anchor{0, 0, 0}, centre{0, 0, 0}, velocity{0, 0, 0}, spin{0, 0, 0};
     SymMat3 inverse_inertia{0, 0, 0, 0, 0, 0};
 };
 MW_INLINE BodyMotion body_motion(const BodySums& b) {
@@ -434,7 +435,7 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
 // (toward a rigid fit, a swinging beam would keep the swing the fit turns with). One thread per
 // object sums its IBPs in slot order (deterministic), then one per IBP.
 inline void lsm_body_damping(const DeviceContext& device, const LsmData d, Real dt, const std::uint32_t* object_ibp_begin,
-                             std::size_t object_count, BodyMotion* motion, Vec3* anchor) {
+                             std::size_t object_count, BodyMotion* motion) {
     parallel_for(device, "lsm_body_motion", object_count, [=] MW_HD(std::size_t o) {
         const LsmObjectParams obj = d.objects[o];
         if (obj.rigid || !(obj.body_damping_rate > Real(0))) return;
@@ -448,9 +449,10 @@ inline void lsm_body_damping(const DeviceContext& device, const LsmData d, Real 
             if (!anchored) a = d.position[i], anchored = true;
             body.add(d.mass[s], d.position[i] - a, d.velocity[i]);
         }
-        anchor[o] = a;
         // A pinned body has no rigid motion to keep: its whole velocity decays.
-        motion[o] = body.M > Real(0) && !pinned ? body_motion(body) : BodyMotion{};
+        BodyMotion m = body.M > Real(0) && !pinned ? body_motion(body) : BodyMotion{};
+        m.anchor = a;
+        motion[o] = m;
     });
     parallel_for(device, "lsm_body_damping", d.ibp_count, [=] MW_HD(std::size_t si) {
         const std::uint32_t s = static_cast<std::uint32_t>(si);
@@ -460,7 +462,7 @@ inline void lsm_body_damping(const DeviceContext& device, const LsmData d, Real 
         const LsmObjectParams obj = d.objects[o];
         if (obj.rigid || !(obj.body_damping_rate > Real(0))) return;
         const BodyMotion m = motion[o];
-        const Vec3 rigid = m.velocity + cross(m.spin, (d.position[i] - anchor[o]) - m.centre);
+        const Vec3 rigid = m.velocity + cross(m.spin, (d.position[i] - m.anchor) - m.centre);
         d.velocity[i] += (Real(1) - std::exp(-obj.body_damping_rate * dt)) * (rigid - d.velocity[i]);
     });
 }

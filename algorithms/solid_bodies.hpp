@@ -113,7 +113,6 @@ class SolidBodies final : public Module {
             body_damping = body_damping || o.body_damping_rate > Real(0);
         }
         body_motion_.assign(body_damping ? L.objects.size() : 0, BodyMotion{});
-        body_anchor_.assign(body_damping ? L.objects.size() : 0, Vec3{0, 0, 0});
         wall_impulse_.assign(has_rigid_ ? ibp_count_ : 0, Vec3{0, 0, 0});
         gp_rest_.upload(L.gp_rest);
         gp_offsets_.upload(L.gp_offsets);
@@ -279,19 +278,19 @@ class SolidBodies final : public Module {
     SolidSummary step(ParticleStore& store, Real dt, Vec3 gravity, Vec3 domain_min, Vec3 domain_max) {
         const LsmData d = data(store);
         LsmStepParams p;
-        p.dt = dt / Real(substeps(dt));
+        const int n = substeps(dt);
+        p.dt = dt / Real(n);
         p.gravity = gravity;
         p.domain_min = domain_min;
         p.domain_max = domain_max;
         // The fluid's forces (a_ext) hold over the whole step: substeps apply the same impulse.
-        for (int k = substeps(dt); k > 0; --k) {
+        for (int k = 0; k < n; ++k) {
             lsm_region_update(device_, d);
             lsm_particle_update(device_, d, p);
             if (has_rigid_) lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_, wall_impulse_.view().data());
         }
         if (body_motion_.size())
-            lsm_body_damping(device_, d, dt, object_ibp_begin_.view().data(), object_count_, body_motion_.view().data(),
-                             body_anchor_.view().data());
+            lsm_body_damping(device_, d, dt, object_ibp_begin_.view().data(), object_count_, body_motion_.view().data());
         const InterpolationData g = interpolation(store);
         interpolate_geometry(device_, g, dt);
         interpolate_surface(device_, g);
@@ -477,7 +476,7 @@ class SolidBodies final : public Module {
                sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
                object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes() +
-               body_motion_.bytes() + body_anchor_.bytes();
+               body_motion_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -584,7 +583,6 @@ class SolidBodies final : public Module {
     Real substep_ = 0;          // solver.solid_substep
     DeviceArray<Vec3> wall_impulse_;  // per IBP of a rigid object, its walls' impulses this step
     DeviceArray<BodyMotion> body_motion_;  // per object, with lsm.body_damping: its rigid motion this step
-    DeviceArray<Vec3> body_anchor_;        // ... and the IBP its sums are taken from
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;
     DeviceArray<Vec3> rest_;
