@@ -2,8 +2,18 @@
 // 2012), which weighs its share in the fluid's density and forces. The static boundary's are
 // computed once at set-up; the moving solids' every step (stage "solid_volumes"), as their
 // particles spread and bunch up.
+//
+// A melting object is a lattice at the fluid's spacing that fills its volume (docs/melting.md), as
+// a block of fluid would: each of its particles weighs a fluid particle's volume m/ρ0. Akinci's
+// volume would swell its outer layers, which stand in for layers missing behind a single-layer
+// boundary; behind a lattice's face those layers exist, and fluid one spacing from the face read
+// 8% over-dense per face (16% between two lattices), enough to spray each newly melted particle
+// out of the gap it melted in (tests/core/test_stefan.cpp).
 #pragma once
+#include <vector>
+
 #include "algorithms/module.hpp"
+#include "simulation/simulation.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -11,12 +21,21 @@ MW_BACKEND_BEGIN
 // particles [first, first + count). Static particles see static neighbours only (computed once);
 // moving solids see moving solids and static walls. Branch-free terms (W_r2 is 0 out of range by
 // itself), as in the PCISPH sums: a boundary particle's neighbourhood is dense (walls at r0/2), and
-// whether a candidate is in range is unpredictable.
+// whether a candidate is in range is unpredictable. A particle of an object flagged in
+// `lattice_object` (indexed by object, empty for static particles) weighs `lattice_volume`.
 template <class Kernel>
 void compute_boundary_volumes(const DeviceContext& device, GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
-                              std::size_t count, bool moving, Kernel kernel) {
+                              std::size_t count, bool moving, Kernel kernel, View<const std::int32_t> object = {},
+                              View<const std::uint8_t> lattice_object = {}, Real lattice_volume = 0) {
     parallel_for(device, "boundary_volume", count, [=] MW_HD(std::size_t k) {
         const std::size_t b = first + k;
+        if (lattice_object.size() != 0) {
+            const std::int32_t o = object[b];
+            if (o >= 0 && std::size_t(o) < lattice_object.size() && lattice_object[std::size_t(o)]) {
+                volume[b] = lattice_volume;
+                return;
+            }
+        }
         const Vec3 xb = position[b];
         Real sum = 0;
         auto add = [&](std::uint32_t j) { sum += kernel.W_r2(norm2(xb - position[j])); };
@@ -31,7 +50,7 @@ class BoundaryVolumes final : public Module {
    public:
     // `moving_solids`: the scene has elastic or rigid objects; `heat`: it conducts heat, which
     // reads the solids' volumes even without fluid.
-    BoundaryVolumes(SimulationState<Kernel>& state, bool moving_solids, bool heat)
+    BoundaryVolumes(SimulationState<Kernel>& state, const SimulationSetup& setup, bool moving_solids, bool heat)
         : state_(state), moving_solids_(moving_solids), per_step_(moving_solids && state.has_fluid) {
         const ParticleStore& store = state.store;
         // Only fluid next to boundary particles reads them: without fluid (but for heat), or
@@ -40,6 +59,11 @@ class BoundaryVolumes final : public Module {
         // re-indexing.
         const bool for_fluid = state.has_fluid && (store.static_count() > 0 || moving_solids);
         if (for_fluid || (heat && moving_solids)) volume_.resize(store.size());
+        std::vector<std::uint8_t> lattice(setup.solids.size(), 0);
+        bool any_lattice = false;
+        for (std::size_t k = 0; k < setup.solids.size(); ++k) any_lattice |= (lattice[k] = setup.solids[k].melts() ? 1 : 0) != 0;
+        if (any_lattice) lattice_object_.upload(lattice);
+        lattice_volume_ = state.fluid.mass / state.fluid.rest_density;
     }
 
     // The static boundary's volumes, once: they see static neighbours only.
@@ -57,18 +81,21 @@ class BoundaryVolumes final : public Module {
     // The moving solids' boundary particles' volumes, over the current grid.
     void update_moving(const GridView& grid, const GroupRanges& ranges) {
         compute_boundary_volumes(state_.device, grid, state_.store.position.cview(), volume_.view(), ranges.fluid_end,
-                                 ranges.solid_end - ranges.fluid_end, true, state_.fluid.kernel);
+                                 ranges.solid_end - ranges.fluid_end, true, state_.fluid.kernel, state_.store.object.cview(),
+                                 lattice_object_.cview(), lattice_volume_);
     }
     bool moving_solids() const { return moving_solids_; }
     // Whether the step keeps them current (fluid and moving solids).
     bool updated_every_step() const { return per_step_; }
     View<const Real> volumes() const { return volume_.cview(); }
-    std::size_t bytes() const override { return volume_.bytes(); }
+    std::size_t bytes() const override { return volume_.bytes() + lattice_object_.bytes(); }
 
    private:
     SimulationState<Kernel>& state_;
     bool moving_solids_ = false, per_step_ = false;
-    DeviceArray<Real> volume_;  // V_b, indexed like the store
+    DeviceArray<Real> volume_;                   // V_b, indexed like the store
+    DeviceArray<std::uint8_t> lattice_object_;   // per object: 1 for a melting object's lattice (empty: none)
+    Real lattice_volume_ = 0;                    // a fluid particle's volume m/ρ0
 };
 
 MW_BACKEND_END

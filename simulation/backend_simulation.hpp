@@ -244,7 +244,7 @@ void BackendSimulation<Kernel>::build_modules(const SimulationSetup& setup, cons
     search.on_sorted([&solids, &store] {
         if (solids.active()) solids.update_slot_map(store);  // slot -> store index after the sort
     });
-    BoundaryVolumes<Kernel>& volumes = add<BoundaryVolumes<Kernel>>(state_, solids.active(), params_.heat.enabled);
+    BoundaryVolumes<Kernel>& volumes = add<BoundaryVolumes<Kernel>>(state_, setup, solids.active(), params_.heat.enabled);
     HeatConduction<Kernel>& heat = add<HeatConduction<Kernel>>(state_, setup, order, volumes, solids);
     add<PhaseChange>(device_, setup, store, solids, state_.counts, params_.fluid.rest_density);
     add<FluidEmitters>(device_, setup, store, state_.counts, params_.fluid.rest_density, params_.gravity);
