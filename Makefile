@@ -5,7 +5,7 @@ JOBS ?= $(shell nproc)
 OUT ?= results/demo
 export BUILD_DIR
 
-.PHONY: setup build demo test bench sanitize fuzz ci ci-short clean
+.PHONY: setup build demo test bench sweep sanitize fuzz ci ci-short clean
 
 setup:
 	@./scripts/setup.sh
@@ -23,6 +23,13 @@ test: build
 
 bench: build
 	@./bench/run_benchmarks.sh $(BUILD_DIR)
+
+# The speed–accuracy sweep (bench/sweep.py): error against cost on the validation cases, as a CSV,
+# a plot and a report under bench/results/. make sweep SWEEP_ARGS=--quick for a shorter one.
+PYTHON ?= /usr/bin/python3
+sweep: setup
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target meltwater_python
+	@$(PYTHON) bench/sweep.py --build $(BUILD_DIR) $(SWEEP_ARGS)
 
 # Every test under AddressSanitizer and UndefinedBehaviorSanitizer (clang, no CUDA), or the ctest
 # selection given: make sanitize TESTS="-L '^cli$$'".

@@ -1,0 +1,462 @@
+#!/usr/bin/env python3
+"""The speed–accuracy trade: validation cases swept over the solver's settings.
+
+    make sweep                      # or: PYTHONPATH=build/python /usr/bin/python3 bench/sweep.py
+    bench/sweep.py --quick          # fewer, cheaper points (about a quarter of the time)
+    bench/sweep.py --smoke OUT      # one short point a case: checks the pipeline (a ctest)
+
+Each point is one case run with one setting changed from the method's defaults, in its own
+process (a runaway stops that point, not the sweep). For each point: the case's error against
+its reference and the cost (wall milliseconds per simulated second, PCISPH iterations per step).
+Output, in bench/results/DATE-cpu-Nthreads-sweep/ (or OUT): sweep.csv, sweep.png (error against cost,
+one panel per case, the Pareto front drawn) and report.md (the tables, the front, and the
+cheapest point per purpose). The cases, their references and how they are measured:
+docs/validation.md, "The speed–accuracy trade".
+
+Cases:
+- hydrostatic: a column 1 m tall and 10 r0 wide, from rest, 2 s. Error: the pressure gradient's
+  deviation from ρ0 g, fitted to the per-layer means of the raw particle pressures (no
+  smoothing), averaged over every step of the last 0.5 s, for layers more than 3 r0 below the
+  surface and 2 r0 above the floor. Also reported: the pressure of fluid within r0 of a side wall
+  over ρ0 g (H − y), averaged likewise, and the kinetic energy at the end.
+- dam_break: Martin & Moyce (1952), n² = 2, a = 0.2 m, as a slab 4 r0 thick (tests/core/
+  test_dam_break.cpp). Error: the largest deviation of the column's residual height H/(2a) from
+  their Table 6 at τ = 0.56 … 1.84.
+- floating: a rigid box (0.16 × 0.08 × 0.16 m) at ρs/ρf = 0.5 set into a pool at its Archimedes
+  draft, 3 s. Error: the draft's deviation from Archimedes', averaged over every step of the last
+  1 s (draft: the pool's level far from the box, less the box's lowest particle; the level: the
+  median over r0-wide columns of each column's highest particle, plus r0/2).
+
+Settings (one at a time from the defaults: fixed 1 ms steps, η 1%, the peak bound 5 η, the cubic
+spline at h = 2 r0, the case's r0, one wall layer at r0/2, both corrections): the step (fixed,
+CFL numbers, largest steps up to the paper's 0.03 s), η and the peak bound, r0, kernel and h/r0,
+the boundary's spacing and layers, the corrections off. Single against double precision needs a
+second build: `--double-build DIR` (a `-DMELTWATER_DOUBLE=ON` build with its Python module) adds
+the defaults run on it. PCISPH is the project's only pressure solver.
+"""
+
+import argparse
+import csv
+import datetime
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+# Martin & Moyce (1952), n² = 2, Table 6 (docs/method.md): residual height against τ = t sqrt(g/a).
+TAU_MM = [0.56, 0.77, 0.93, 1.08, 1.28, 1.46, 1.66, 1.84]
+H_MM = [0.94, 0.89, 0.83, 0.78, 0.72, 0.67, 0.61, 0.56]
+
+# ---- the cases: each builds its scene at spacing r0 and measures its error from a Simulation ----
+
+
+def hydrostatic_scene(r0):
+    width, height = 10 * r0, 1.0
+    return {
+        "name": "sweep_hydrostatic",
+        "domain": {"min": [0, 0, 0], "max": [width, height + 0.2, width]},
+        "fluid": {"rest_density": 1000, "spacing": r0, "viscosity": 0},
+        "fluid_blocks": [{"min": [0, 0, 0], "max": [width, height, width]}],
+    }
+
+
+def hydrostatic_measure(meltwater, sim, r0, settle):
+    import numpy as np
+
+    rho_g = 1000 * 9.81
+    width = 10 * r0
+    report = sim.run(until=max(settle - 0.5, 0.5 * settle))
+    # Per-layer mean pressures, averaged over every step of the last half second (or half the run):
+    # the column still breathes after the settling, and one instant would catch it mid-swing.
+    sums, counts, wall_ratios, surfaces = {}, {}, [], []
+    while sim.time < settle:
+        report = sim.step()
+        fluid = sim.type == meltwater.FLUID
+        x = sim.position[fluid, 0].astype(float)
+        y = sim.position[fluid, 1].astype(float)
+        p = sim.pressure[fluid].astype(float)
+        surface = float(np.median(np.sort(y)[-int(len(y) * 0.01) - 1:])) + r0 / 2
+        surfaces.append(surface)
+        layer = np.floor(y / r0).astype(int)
+        for k in np.unique(layer):
+            sel = layer == k
+            sums[k] = sums.get(k, 0.0) + float(p[sel].sum())
+            counts[k] = counts.get(k, 0) + int(sel.sum())
+        wall = ((x < r0) | (x > width - r0)) & (surface - y > 3 * r0) & (y > 2 * r0)
+        wall_ratios.append(float(np.mean(p[wall] / (rho_g * (surface - y[wall])))))
+    surface = float(np.mean(surfaces))
+    depths, means = [], []
+    for k in sorted(sums):
+        centre = (k + 0.5) * r0
+        if surface - centre < 3 * r0 or centre < 2 * r0:
+            continue
+        depths.append(surface - centre)
+        means.append(sums[k] / counts[k])
+    slope = np.polyfit(depths, means, 1)[0]
+    return {"error": abs(slope / rho_g - 1), "gradient_ratio": slope / rho_g,
+            "wall_pressure_ratio": float(np.mean(wall_ratios)), "kinetic_energy": report["kinetic_energy"]}, report
+
+
+def dam_break_scene(r0):
+    a, depth = 0.2, 4 * r0
+    return {
+        "name": "sweep_dam_break",
+        "domain": {"min": [0, 0, 0], "max": [5 * a, 2.5 * a, depth]},
+        "fluid": {"rest_density": 1000, "spacing": r0, "viscosity": 0},
+        "fluid_blocks": [{"min": [0, 0, 0], "max": [a, 2 * a, depth]}],
+    }
+
+
+def dam_break_measure(meltwater, sim, r0, settle):
+    a, g = 0.2, 9.81
+    tau_of_t = math.sqrt(g / a)
+    tau_end = TAU_MM[-1] if settle is None else settle * tau_of_t
+    times, heights = [0.0], [1.0]
+    report = None
+    while times[-1] < tau_end:
+        report = sim.step()
+        pos = sim.position[sim.type == meltwater.FLUID]
+        top = pos[pos[:, 0] < a, 1].max()
+        times.append(sim.time * tau_of_t)
+        heights.append((float(top) + r0 / 2) / (2 * a))
+    worst = 0.0
+    for tau, h in zip(TAU_MM, H_MM):
+        if tau > times[-1]:
+            break
+        k = next(i for i, t in enumerate(times) if t >= tau)
+        f = (tau - times[k - 1]) / (times[k] - times[k - 1])
+        value = heights[k - 1] + f * (heights[k] - heights[k - 1])
+        worst = max(worst, abs(value - h) / h)
+    return {"error": worst}, report
+
+
+def floating_scene(r0):
+    return {
+        "name": "sweep_floating",
+        "domain": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]},
+        "fluid": {"rest_density": 1000, "spacing": r0, "viscosity": 0.01},
+        "fluid_blocks": [{"min": [0, 0, 0], "max": [0.4, 0.2, 0.4]}],
+        "objects": [{"name": "box", "mesh": {"procedural": "box:x=0.16,y=0.08,z=0.16"},
+                     "transform": {"translation": [0.2, 0.2, 0.2]}, "kind": "rigid", "density": 500}],
+    }
+
+
+def floating_measure(meltwater, sim, r0, settle):
+    import numpy as np
+
+    archimedes = 0.5 * 0.08
+    window = min(1.0, settle / 2)
+    report = sim.run(until=settle - window)
+    drafts = []
+    while sim.time < settle:
+        report = sim.step()
+        pos, kind = sim.position, sim.type
+        fluid = pos[kind == meltwater.FLUID]
+        far = fluid[(np.abs(fluid[:, 0] - 0.2) > 0.13) | (np.abs(fluid[:, 2] - 0.2) > 0.13)]
+        # The level: the median over r0-wide columns of each column's highest particle, plus r0/2;
+        # a splash's droplets do not move it.
+        column = np.floor(far[:, 0] / r0).astype(int) * 100000 + np.floor(far[:, 2] / r0).astype(int)
+        order = np.lexsort((far[:, 1], column))
+        last = np.r_[column[order][1:] != column[order][:-1], True]
+        level = float(np.median(far[order][last, 1])) + r0 / 2
+        bottom = float(pos[(sim.object == 0) & (kind != meltwater.GEOMETRY), 1].min())
+        drafts.append(level - bottom)
+    draft = float(np.mean(drafts))
+    return {"error": abs(draft - archimedes) / archimedes, "draft": draft, "archimedes": archimedes,
+            "draft_swing": float(np.ptp(drafts))}, report
+
+
+CASES = {
+    # name: (scene, measure, base r0, simulated seconds)
+    "hydrostatic": (hydrostatic_scene, hydrostatic_measure, 0.02, 2.0),
+    "dam_break": (dam_break_scene, dam_break_measure, 0.01, None),
+    "floating": (floating_scene, floating_measure, 0.02, 3.0),
+}
+
+# ---- the settings: a label, its group, and what it changes (scene keys, or r0's factor) ----------
+
+
+def settings(quick):
+    s = [("defaults", "defaults", {})]
+    steps = [("fixed 0.5 ms", {"solver.dt": 0.0005}), ("fixed 2 ms", {"solver.dt": 0.002}),
+             ("fixed 4 ms", {"solver.dt": 0.004}),
+             ("CFL 0.4 under 5 ms", {"solver.dt_mode": "cfl", "solver.cfl_number": 0.4, "solver.dt": 0.005}),
+             ("CFL 0.4 under 30 ms", {"solver.dt_mode": "cfl", "solver.cfl_number": 0.4, "solver.dt": 0.03}),
+             ("CFL 1 under 30 ms", {"solver.dt_mode": "cfl", "solver.cfl_number": 1.0, "solver.dt": 0.03})]
+    eta = [("eta 0.3%", {"solver.eta": 0.003}), ("eta 3%", {"solver.eta": 0.03}),
+           ("no peak bound", {"solver.eta_max": 0})]
+    spacing = [("r0 x 2", {"r0_factor": 2.0}), ("r0 x 2/3", {"r0_factor": 2 / 3})]
+    kernel = [("cubic h 2.25 r0", {"h_factor": 2.25}),
+              ("Wendland h 2 r0", {"fluid.kernel": "wendland_c2"}),
+              ("Wendland h 3 r0", {"fluid.kernel": "wendland_c2", "h_factor": 3.0})]
+    boundary = [("wall spacing r0", {"boundary.spacing_factor": 1.0}), ("2 wall layers", {"boundary.layers": 2}),
+                ("walls' correction off", {"boundary.correction": False})]
+    coupling = [("objects' correction off", {"coupling.correction": False})]
+    if quick:
+        steps = [steps[1], steps[3], steps[5]]
+        eta = eta[1:2]
+        spacing = spacing[:1]
+        kernel = kernel[1:2]
+        boundary = boundary[2:]
+    for group, items in (("step", steps), ("eta", eta), ("spacing", spacing), ("kernel", kernel),
+                         ("boundary", boundary), ("coupling", coupling)):
+        s += [(label, group, change) for label, change in items]
+    return s
+
+
+def applies(case, change):
+    return not ("coupling.correction" in change and case != "floating")
+
+
+# ---- one point, in its own process ----------------------------------------------------------------
+
+
+def run_point(spec):
+    """Runs one case at one setting; prints one JSON line."""
+    import meltwater
+
+    scene_fn, measure, base_r0, seconds = CASES[spec["case"]]
+    change = dict(spec["change"])
+    r0 = base_r0 * change.pop("r0_factor", 1.0)
+    h_factor = change.pop("h_factor", None)
+    scene = scene_fn(r0)
+    if h_factor:
+        change["fluid.support_radius"] = h_factor * r0
+    if spec.get("smoke"):
+        seconds = 0.4 if spec["case"] == "floating" else 0.1
+    out = {"status": "ok"}
+    started = time.monotonic()
+    try:
+        sim = meltwater.Simulation(meltwater.Scene(scene, overrides=change), backend="openmp", threads=spec["threads"])
+        result, _ = measure(meltwater, sim, r0, seconds)
+        out.update(result)
+        out.update(sim_stats(sim))
+    except meltwater.SimulationError as e:
+        out = {"status": "failed", "message": str(e)}
+    out["wall_s"] = time.monotonic() - started
+    out["r0"] = r0
+    print(json.dumps(out))
+
+
+def sim_stats(sim):
+    """Cost over the whole run, from the per-step statistics the simulation keeps."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "stats.csv")
+        sim.write_stats(path)
+        rows = list(csv.DictReader(open(path)))
+    total_ms = sum(float(r["ms_total"]) for r in rows)
+    iterations = sum(float(r["iterations"]) for r in rows)
+    simulated = float(rows[-1]["time"])
+    return {"steps": len(rows), "simulated_s": simulated, "ms_per_simulated_s": total_ms / simulated,
+            "iterations_per_step": iterations / len(rows), "halvings": int(sum(float(r["dt_retries"]) for r in rows))}
+
+
+# ---- the sweep: every point in a child process, then the CSV, the plot and the report ------------
+
+
+def device_name():
+    model = platform.processor() or "CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{os.cpu_count()} cores, {model}"
+
+
+def run_child(spec, pythonpath, timeout):
+    env = dict(os.environ, PYTHONPATH=pythonpath)
+    try:
+        done = subprocess.run([sys.executable, os.path.abspath(__file__), "--point", json.dumps(spec)], env=env,
+                              capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"status": "failed", "message": f"ran past the sweep's {timeout} s limit a point"}
+    lines = [l for l in done.stdout.splitlines() if l.startswith("{")]
+    if done.returncode != 0 or not lines:
+        tail = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        return {"status": "failed", "message": f"exit {done.returncode}: {tail}"}
+    return json.loads(lines[-1])
+
+
+def pareto(points):
+    """The points no other point beats on both cost and error, cheapest first."""
+    ok = sorted((p for p in points if p["status"] == "ok"), key=lambda p: (p["ms_per_simulated_s"], p["error"]))
+    front, best = [], math.inf
+    for p in ok:
+        if p["error"] < best:
+            front.append(p)
+            best = p["error"]
+    return front
+
+
+PURPOSES = [
+    # name, the rule that picks its point among the case's successful runs
+    ("preview", "the cheapest point with an error under 10%", lambda p: p["error"] < 0.10),
+    ("production", "the cheapest point with an error under 3%", lambda p: p["error"] < 0.03),
+    ("validation", "the point with the smallest error", None),
+]
+
+
+def pick(points, rule):
+    ok = [p for p in points if p["status"] == "ok"]
+    if rule is None:
+        return min(ok, key=lambda p: p["error"]) if ok else None
+    fitting = [p for p in ok if rule(p)]
+    return min(fitting, key=lambda p: p["ms_per_simulated_s"]) if fitting else None
+
+
+COLUMNS = ["case", "setting", "group", "status", "error", "ms_per_simulated_s", "iterations_per_step", "steps",
+           "halvings", "simulated_s", "wall_s", "r0", "pareto", "details", "message"]
+
+
+def write_outputs(rows, out_dir, device, command, quick):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cases = [c for c in CASES if any(r["case"] == c for r in rows)]
+    for c in cases:
+        for p in pareto([r for r in rows if r["case"] == c]):
+            p["pareto"] = True
+    with open(os.path.join(out_dir, "sweep.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow(dict(r, pareto=int(bool(r.get("pareto")))))
+
+    groups = sorted({r["group"] for r in rows})
+    colours = dict(zip(groups, plt.rcParams["axes.prop_cycle"].by_key()["color"] * 3))
+    fig, axes = plt.subplots(1, len(cases), figsize=(6.2 * len(cases), 5.2), squeeze=False)
+    for ax, c in zip(axes[0], cases):
+        pts = [r for r in rows if r["case"] == c and r["status"] == "ok"]
+        for g in groups:
+            sel = [r for r in pts if r["group"] == g]
+            if sel:
+                ax.scatter([r["ms_per_simulated_s"] / 1000 for r in sel], [max(r["error"], 1e-4) * 100 for r in sel],
+                           color=colours[g], label=g, s=36, zorder=3)
+        for r in pts:
+            ax.annotate(r["setting"], (r["ms_per_simulated_s"] / 1000, max(r["error"], 1e-4) * 100), fontsize=7,
+                        xytext=(4, 3), textcoords="offset points")
+        front = pareto(pts)
+        ax.step([r["ms_per_simulated_s"] / 1000 for r in front], [max(r["error"], 1e-4) * 100 for r in front],
+                where="post", color="black", lw=1.2, label="Pareto front", zorder=2)
+        failed = [r["setting"] for r in rows if r["case"] == c and r["status"] != "ok"]
+        if failed:
+            ax.text(0.02, 0.02, "failed: " + ", ".join(failed), transform=ax.transAxes, fontsize=7, color="crimson",
+                    wrap=True)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("cost: wall seconds per simulated second")
+        ax.set_ylabel("error, %")
+        ax.set_title(c)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"Meltwater: error against cost ({device}, OpenMP)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, "sweep.png"), dpi=110)
+
+    lines = [f"# Speed–accuracy sweep{' (quick)' if quick else ''}", "",
+             f"- device: {device}, OpenMP, float unless a row says double",
+             f"- command: `{command}`",
+             f"- date: {datetime.date.today().isoformat()}",
+             "- cases, measures and settings: `bench/sweep.py`'s docstring and docs/validation.md, "
+             "\"The speed–accuracy trade\"; the plot: `sweep.png`; every number: `sweep.csv`",
+             "- cost: wall milliseconds per simulated second over the whole run (sum of `ms_total`), on a VM "
+             "that drifts 20–50% between runs: compare within this report only", ""]
+    for c in cases:
+        pts = [r for r in rows if r["case"] == c]
+        lines += [f"## {c}", "", "| setting | error | ms per simulated s | iterations/step | steps | halvings | Pareto | details |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for r in sorted(pts, key=lambda r: (r["status"] != "ok", r.get("ms_per_simulated_s", 0))):
+            if r["status"] != "ok":
+                lines.append(f"| {r['setting']} | failed | | | | | | {r.get('message', '')[:160]} |")
+                continue
+            lines.append(f"| {r['setting']} | {100 * r['error']:.2f}% | {r['ms_per_simulated_s']:.0f} | "
+                         f"{r['iterations_per_step']:.1f} | {r['steps']} | {r['halvings']} | "
+                         f"{'yes' if r.get('pareto') else ''} | {r.get('details', '')} |")
+        lines += ["", "| purpose | rule | setting | error | ms per simulated s |", "| --- | --- | --- | --- | --- |"]
+        for name, text, rule in PURPOSES:
+            p = pick(pts, rule)
+            if p:
+                error, cost = "%.2f%%" % (100 * p["error"]), "%.0f" % p["ms_per_simulated_s"]
+                lines.append(f"| {name} | {text} | {p['setting']} | {error} | {cost} |")
+            else:
+                lines.append(f"| {name} | {text} | none meets it | | |")
+        lines.append("")
+    with open(os.path.join(out_dir, "report.md"), "w") as f:
+        f.write("\n".join(lines))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", nargs="?", help="output folder (default bench/results/DATE-cpu-Nthreads-sweep)")
+    parser.add_argument("--build", default=os.path.join(ROOT, "build"), help="the build with the Python module")
+    parser.add_argument("--double-build", help="a -DMELTWATER_DOUBLE=ON build: adds the defaults in double")
+    parser.add_argument("--cases", default=",".join(CASES), help="comma-separated cases (default: all)")
+    parser.add_argument("--quick", action="store_true", help="fewer settings, no finer spacing")
+    parser.add_argument("--smoke", action="store_true", help="the defaults only, each case cut short")
+    parser.add_argument("--threads", type=int, default=0, help="OpenMP threads (default: all cores)")
+    parser.add_argument("--timeout", type=int, default=900, help="seconds a point may take (default 900)")
+    parser.add_argument("--point", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.point:
+        run_point(json.loads(args.point))
+        return 0
+    cases = [c for c in args.cases.split(",") if c]
+    unknown = [c for c in cases if c not in CASES]
+    if unknown:
+        print(f"sweep.py: unknown case {unknown[0]!r} (cases: {', '.join(CASES)})", file=sys.stderr)
+        return 2
+    pythonpath = os.path.join(os.path.abspath(args.build), "python")
+    if not any(n.startswith("meltwater") for n in (os.listdir(pythonpath) if os.path.isdir(pythonpath) else [])):
+        print(f"sweep.py: no Python module in {pythonpath}: build it (cmake --build {args.build} --target "
+              "meltwater_python) or name the build with --build", file=sys.stderr)
+        return 2
+    device = device_name()
+    if args.out:
+        out_dir = args.out
+    else:
+        threads = args.threads or os.cpu_count()
+        out_dir = os.path.join(HERE, "results", f"{datetime.date.today().isoformat()}-cpu-{threads}threads-sweep")
+    os.makedirs(out_dir, exist_ok=True)
+    points = [("defaults", "defaults", {})] if args.smoke else settings(args.quick)
+    plan = [(c, label, group, change) for c in cases for label, group, change in points if applies(c, change)]
+    if args.double_build:
+        plan += [(c, "defaults, double", "precision", {"__build": args.double_build}) for c in cases]
+    rows = []
+    started = time.monotonic()
+    for n, (case, label, group, change) in enumerate(plan, 1):
+        build = change.get("__build")
+        change = {k: v for k, v in change.items() if k != "__build"}
+        path = os.path.join(os.path.abspath(build), "python") if build else pythonpath
+        spec = {"case": case, "change": change, "threads": args.threads, "smoke": args.smoke}
+        result = run_child(spec, path, args.timeout)
+        row = {"case": case, "setting": label, "group": group}
+        row.update(result)
+        extra = {k: v for k, v in result.items() if k not in COLUMNS and k not in ("status",)}
+        row["details"] = ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in extra.items())
+        rows.append(row)
+        shown = f"error {100 * result['error']:.2f}%, {result['ms_per_simulated_s']:.0f} ms/simulated s" \
+            if result["status"] == "ok" else f"failed: {result.get('message', '')[:120]}"
+        print(f"[{n}/{len(plan)}, {time.monotonic() - started:.0f} s] {case}, {label}: {shown}", flush=True)
+    command = "bench/sweep.py " + " ".join(a for a in sys.argv[1:])
+    write_outputs(rows, out_dir, device, command.strip(), args.quick)
+    print(f"sweep.py: {len(rows)} points; results in {out_dir} (sweep.csv, sweep.png, report.md)")
+    failed = sum(r["status"] != "ok" for r in rows)
+    return 1 if args.smoke and failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
