@@ -2,8 +2,9 @@
 """The speed–accuracy trade: validation cases swept over the solver's settings.
 
     make sweep                      # or: PYTHONPATH=build/python /usr/bin/python3 bench/sweep.py
-    bench/sweep.py --quick          # fewer, cheaper points (about a quarter of the time)
+    bench/sweep.py --quick          # 33 of the 73 points, none at the finer spacing
     bench/sweep.py --smoke OUT      # one short point a case: checks the pipeline (a ctest)
+    bench/sweep.py --replot OUT     # redraws OUT's plot and report from its sweep.csv
 
 Each point is one case run with one setting changed from the method's defaults, in its own
 process (a runaway stops that point, not the sweep). For each point: the case's error against
@@ -27,6 +28,11 @@ Cases:
   draft, 3 s. Error: the draft's deviation from Archimedes', averaged over every step of the last
   1 s (draft: the pool's level far from the box, less the box's lowest particle; the level: the
   median over r0-wide columns of each column's highest particle, plus r0/2).
+- stefan: tests/core/test_stefan.cpp's slab at St 0.3 as a scene (a pinned lattice plate held at
+  T_m + 10 K, a pinned slab of solid at T_m, no gravity, α 0.08 m²/s, 8 x 8 lattice columns). Error:
+  λ fitted to the steps at which the 4 x 4 central columns' mean melted count passes each whole
+  layer (from the third to the tenth) against the one-phase Stefan problem's λ. A front that has
+  not passed ten layers by four times the analytic time fails the point.
 
 Settings (one at a time from the defaults: fixed 1 ms steps, η 1%, the peak bound 5 η, the cubic
 spline at h = 2 r0, the case's r0, one wall layer at r0/2, both corrections): the step (fixed,
@@ -184,11 +190,83 @@ def floating_measure(meltwater, sim, r0, settle):
             "draft_swing": float(np.ptp(drafts))}, report
 
 
+def stefan_scene(r0, stefan=0.3, layers=10):
+    # tests/core/test_stefan.cpp's slab as a scene: a pinned lattice plate at 10 °C with 10⁶ times
+    # the liquid's heat capacity (a melting point it never reaches makes it a lattice), and a slab
+    # of solid at its melting point 0 °C one spacing from it; no gravity.
+    capacity, alpha, width, plate = 4.18e6, 0.08, 8 * r0, 4 * r0
+    length = (layers + 4) * r0
+    lo = [0.1, 0.1, 0.1]
+    side = [lo[1], lo[1] + width]
+    def box(x0, x1):
+        return {"procedural": f"box:x={x1 - x0:.6g},y={width:.6g},z={width:.6g}"}, [(x0 + x1) / 2, lo[1] + width / 2,
+                                                                                  lo[2] + width / 2]
+    plate_mesh, plate_centre = box(lo[0], lo[0] + plate)
+    slab_mesh, slab_centre = box(lo[0] + plate, lo[0] + plate + length)
+    return {
+        "name": "sweep_stefan",
+        "domain": {"min": [0, 0, 0], "max": [lo[0] + plate + length + 0.1, side[1] + 0.1, side[1] + 0.1]},
+        "gravity": [0, 0, 0],
+        "fluid": {"rest_density": 1000, "spacing": r0, "viscosity": 0, "thermal_diffusivity": alpha,
+                  "heat_capacity": capacity, "temperature": 0},
+        "heat": {"enabled": True, "max_substeps": 64},
+        "objects": [
+            {"name": "plate", "mesh": plate_mesh, "transform": {"translation": plate_centre}, "kind": "elastic",
+             "density": 1000, "temperature": 10, "heat_capacity": 1e6 * capacity, "melting_point": 1e4,
+             "pinned": {"box": {"min": [0, 0, 0], "max": [lo[0] + plate, 1, 1]}}},
+            {"name": "slab", "mesh": slab_mesh, "transform": {"translation": slab_centre}, "kind": "elastic",
+             "density": 1000, "temperature": 0, "melting_point": 0, "latent_heat": 10 / stefan * capacity / 1000,
+             "pinned": {"box": {"min": [lo[0] + plate, 0, 0], "max": [1, 1, 1]}}},
+        ],
+    }
+
+
+def stefan_lambda(stefan):
+    lo, hi = 0.0, 3.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid * math.exp(mid * mid) * math.erf(mid) < stefan / math.sqrt(math.pi):
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def stefan_measure(meltwater, sim, r0, settle, stefan=0.3, layers=10):
+    import numpy as np
+
+    alpha, width = 0.08, 8 * r0
+    centre = 0.1 + width / 2
+    analytic = stefan_lambda(stefan)
+    # 10 layers take (10 r0 / 2λ)² / α; four times that is the limit before calling the front stalled.
+    limit = settle if settle is not None else 4 * (layers * r0 / (2 * analytic)) ** 2 / alpha
+    x0 = sim.position.copy()
+    slab = sim.object == 1
+    central = slab & (np.abs(x0[:, 1] - centre) < 2 * r0) & (np.abs(x0[:, 2] - centre) < 2 * r0)
+    columns = 16
+    crossed, st, tt = 0, 0.0, 0.0
+    report = None
+    while sim.time < limit and crossed < layers:
+        report = sim.step()
+        melted = np.count_nonzero(central & (sim.type == meltwater.FLUID)) / columns
+        while crossed < layers and melted >= crossed + 1:
+            crossed += 1
+            if crossed > 2:
+                root = 2 * math.sqrt(alpha * sim.time)
+                st += crossed * r0 * root
+                tt += root * root
+    if settle is None and crossed < layers:
+        raise meltwater.SimulationError(f"the front stalled at {crossed} of {layers} layers by t = {sim.time:.3g} s")
+    fitted = st / tt if tt > 0 else 0.0
+    return {"error": abs(fitted / analytic - 1), "lambda": fitted, "analytic_lambda": analytic, "layers": crossed}, report
+
+
 CASES = {
     # name: (scene, measure, base r0, simulated seconds)
     "hydrostatic": (hydrostatic_scene, hydrostatic_measure, 0.02, 2.0),
     "dam_break": (dam_break_scene, dam_break_measure, 0.01, None),
     "floating": (floating_scene, floating_measure, 0.02, 3.0),
+    "stefan": (stefan_scene, stefan_measure, 0.02, None),
 }
 
 # ---- the settings: a label, its group, and what it changes (scene keys, or r0's factor) ----------
@@ -241,7 +319,7 @@ def run_point(spec):
     if h_factor:
         change["fluid.support_radius"] = h_factor * r0
     if spec.get("smoke"):
-        seconds = 0.4 if spec["case"] == "floating" else 0.1
+        seconds = {"floating": 0.4, "stefan": 0.2}.get(spec["case"], 0.1)
     out = {"status": "ok"}
     started = time.monotonic()
     try:
@@ -350,8 +428,12 @@ def write_outputs(rows, out_dir, device, command, quick):
 
     groups = sorted({r["group"] for r in rows})
     colours = dict(zip(groups, plt.rcParams["axes.prop_cycle"].by_key()["color"] * 3))
-    fig, axes = plt.subplots(1, len(cases), figsize=(6.2 * len(cases), 5.2), squeeze=False)
-    for ax, c in zip(axes[0], cases):
+    ncols = min(2, len(cases))
+    nrows = (len(cases) + ncols - 1) // ncols
+    fig, axes = plt.subplots(nrows, ncols, figsize=(7.0 * ncols, 5.2 * nrows), squeeze=False)
+    for ax in axes.flat[len(cases):]:
+        ax.axis("off")
+    for ax, c in zip(axes.flat, cases):
         pts = [r for r in rows if r["case"] == c and r["status"] == "ok"]
         for g in groups:
             sel = [r for r in pts if r["group"] == g]
@@ -381,7 +463,7 @@ def write_outputs(rows, out_dir, device, command, quick):
 
     lines = [f"# Speed–accuracy sweep{' (quick)' if quick else ''}", "",
              f"- device: {device}, OpenMP, float unless a row says double",
-             f"- command: `{command}`",
+             f"- command: {command}",
              f"- date: {datetime.date.today().isoformat()}",
              "- cases, measures and settings: `bench/sweep.py`'s docstring and docs/validation.md, "
              "\"The speed–accuracy trade\"; the plot: `sweep.png`; every number: `sweep.csv`",
@@ -411,6 +493,29 @@ def write_outputs(rows, out_dir, device, command, quick):
         f.write("\n".join(lines))
 
 
+def replot(out_dir):
+    """Redraws sweep.png and report.md from out_dir/sweep.csv, keeping the report's device and command."""
+    path = os.path.join(out_dir or "", "sweep.csv")
+    if not out_dir or not os.path.isfile(path):
+        print(f"sweep.py: --replot needs a folder with a sweep.csv (got {out_dir!r})", file=sys.stderr)
+        return 2
+    rows = []
+    for r in csv.DictReader(open(path)):
+        for k in ("error", "ms_per_simulated_s", "iterations_per_step", "simulated_s", "wall_s", "r0"):
+            r[k] = float(r[k]) if r.get(k) else None
+        for k in ("steps", "halvings"):
+            r[k] = int(float(r[k])) if r.get(k) else None
+        r["pareto"] = False
+        rows.append(r)
+    report = os.path.join(out_dir, "report.md")
+    head = open(report).read().splitlines() if os.path.isfile(report) else []
+    device = next((l.split(": ", 1)[1].split(", OpenMP")[0] for l in head if l.startswith("- device: ")), device_name())
+    command = next((l[len("- command: "):] for l in head if l.startswith("- command: ")), "`bench/sweep.py`")
+    write_outputs(rows, out_dir, device, command, "(quick)" in (head[0] if head else ""))
+    print(f"sweep.py: redrew {out_dir}/sweep.png and report.md from {len(rows)} points")
+    return 0
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", nargs="?", help="output folder (default bench/results/DATE-cpu-Nthreads-sweep)")
@@ -421,11 +526,14 @@ def main():
     parser.add_argument("--smoke", action="store_true", help="the defaults only, each case cut short")
     parser.add_argument("--threads", type=int, default=0, help="OpenMP threads (default: all cores)")
     parser.add_argument("--timeout", type=int, default=900, help="seconds a point may take (default 900)")
+    parser.add_argument("--replot", action="store_true", help="redraw OUT's plot and report from its sweep.csv")
     parser.add_argument("--point", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.point:
         run_point(json.loads(args.point))
         return 0
+    if args.replot:
+        return replot(args.out)
     cases = [c for c in args.cases.split(",") if c]
     unknown = [c for c in cases if c not in CASES]
     if unknown:
@@ -464,7 +572,7 @@ def main():
             if result["status"] == "ok" else f"failed: {result.get('message', '')[:120]}"
         print(f"[{n}/{len(plan)}, {time.monotonic() - started:.0f} s] {case}, {label}: {shown}", flush=True)
     command = "bench/sweep.py " + " ".join(a for a in sys.argv[1:])
-    write_outputs(rows, out_dir, device, command.strip(), args.quick)
+    write_outputs(rows, out_dir, device, f"`{command.strip()}`", args.quick)
     print(f"sweep.py: {len(rows)} points; results in {out_dir} (sweep.csv, sweep.png, report.md)")
     failed = sum(r["status"] != "ok" for r in rows)
     return 1 if args.smoke and failed else 0

@@ -1,5 +1,6 @@
 # bench/sweep.py, the speed–accuracy sweep: its Pareto front and purposes on made-up points, and
-# its whole pipeline (three cases cut short, in child processes) writing the CSV, plot and report.
+# its whole pipeline (every case cut short, in child processes) writing the CSV, plot and report,
+# and --replot redrawing them from the CSV.
 import csv
 import importlib.util
 import math
@@ -49,6 +50,13 @@ def test_a_smoke_sweep_writes_the_csv_the_plot_and_the_report(tmp_path):
     for case in sweep.CASES:
         assert f"## {case}" in report
     assert "| production |" in report
+    # --replot redraws the same report from the CSV alone.
+    (out / "sweep.png").unlink()
+    again = subprocess.run([sys.executable, str(REPO / "bench" / "sweep.py"), "--replot", str(out)],
+                           capture_output=True, text=True, env=env, timeout=120)
+    assert again.returncode == 0, again.stderr
+    assert (out / "report.md").read_text() == report
+    assert (out / "sweep.png").stat().st_size > 10_000
 
 
 def test_an_unknown_case_is_refused_in_one_line(tmp_path):
