@@ -2,7 +2,7 @@
 """The speed–accuracy trade: validation cases swept over the solver's settings.
 
     make sweep                      # or: PYTHONPATH=build/python /usr/bin/python3 bench/sweep.py
-    bench/sweep.py --quick          # 33 of the 73 points, none at the finer spacing
+    bench/sweep.py --quick          # 37 of the 79 points, none at the finer spacing
     bench/sweep.py --smoke OUT      # one short point a case: checks the pipeline (a ctest)
     bench/sweep.py --replot OUT     # redraws OUT's plot and report from its sweep.csv
 
@@ -27,7 +27,8 @@ Cases:
 - floating: a rigid box (0.16 × 0.08 × 0.16 m) at ρs/ρf = 0.5 set into a pool at its Archimedes
   draft, 3 s. Error: the draft's deviation from Archimedes', averaged over every step of the last
   1 s (draft: the pool's level far from the box, less the box's lowest particle; the level: the
-  median over r0-wide columns of each column's highest particle, plus r0/2).
+  median over r0-wide columns of each column's highest particle, plus r0/2). floating_0.3 and
+  floating_0.9: the same at those ratios, at the defaults and the other spacings only.
 - stefan: tests/core/test_stefan.cpp's slab at St 0.3 as a scene (a pinned lattice plate held at
   T_m + 10 K, a pinned slab of solid at T_m, no gravity, α 0.08 m²/s, 8 x 8 lattice columns). Error:
   λ fitted to the steps at which the 4 x 4 central columns' mean melted count passes each whole
@@ -154,21 +155,24 @@ def dam_break_measure(meltwater, sim, r0, settle):
     return {"error": worst}, report
 
 
-def floating_scene(r0):
+def floating_scene(r0, ratio=0.5):
+    # The box's centre where its bottom sits at Archimedes' draft below the 0.2 m surface.
+    draft = ratio * 0.08
     return {
         "name": "sweep_floating",
         "domain": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]},
         "fluid": {"rest_density": 1000, "spacing": r0, "viscosity": 0.01},
         "fluid_blocks": [{"min": [0, 0, 0], "max": [0.4, 0.2, 0.4]}],
         "objects": [{"name": "box", "mesh": {"procedural": "box:x=0.16,y=0.08,z=0.16"},
-                     "transform": {"translation": [0.2, 0.2, 0.2]}, "kind": "rigid", "density": 500}],
+                     "transform": {"translation": [0.2, 0.2 - draft + 0.04, 0.2]}, "kind": "rigid",
+                     "density": 1000 * ratio}],
     }
 
 
-def floating_measure(meltwater, sim, r0, settle):
+def floating_measure(meltwater, sim, r0, settle, ratio=0.5):
     import numpy as np
 
-    archimedes = 0.5 * 0.08
+    archimedes = ratio * 0.08
     window = min(1.0, settle / 2)
     report = sim.run(until=settle - window)
     drafts = []
@@ -266,6 +270,9 @@ CASES = {
     "hydrostatic": (hydrostatic_scene, hydrostatic_measure, 0.02, 2.0),
     "dam_break": (dam_break_scene, dam_break_measure, 0.01, None),
     "floating": (floating_scene, floating_measure, 0.02, 3.0),
+    # The same box at other density ratios, over the spacings only (applies()).
+    "floating_0.3": (lambda r0: floating_scene(r0, 0.3), lambda *a: floating_measure(*a, ratio=0.3), 0.02, 3.0),
+    "floating_0.9": (lambda r0: floating_scene(r0, 0.9), lambda *a: floating_measure(*a, ratio=0.9), 0.02, 3.0),
     "stefan": (stefan_scene, stefan_measure, 0.02, None),
 }
 
@@ -301,6 +308,8 @@ def settings(quick):
 
 
 def applies(case, change):
+    if case.startswith("floating_"):
+        return not change or set(change) == {"r0_factor"}
     return not ("coupling.correction" in change and case != "floating")
 
 
@@ -319,7 +328,7 @@ def run_point(spec):
     if h_factor:
         change["fluid.support_radius"] = h_factor * r0
     if spec.get("smoke"):
-        seconds = {"floating": 0.4, "stefan": 0.2}.get(spec["case"], 0.1)
+        seconds = 0.4 if spec["case"].startswith("floating") else {"stefan": 0.2}.get(spec["case"], 0.1)
     out = {"status": "ok"}
     started = time.monotonic()
     try:
