@@ -114,7 +114,8 @@ Floating float_box(double density_ratio, Real r0, bool correction = false) {
     long ibps = 0;
     for (const auto t : setup.type) ibps += t == kInnerBoundary;
     const double weight = ibps * double(solid.density) * r0 * r0 * r0 * 9.81;
-    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    const test::OneHostThread one_host_thread;
+    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 1);
     Floating out;
     int samples = 0;
     double timed = 0;  // s

@@ -59,7 +59,8 @@ Throw throw_into_pool(SolidKind kind, double density, Real cfl) {
     const double fluid_mass = test::lattice_mass(CubicSpline3D::with_support(2 * kR0), kR0, 1000.0);
     const double ibp_mass = density * double(kR0) * kR0 * kR0;
 
-    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    const test::OneHostThread one_host_thread;
+    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 1);
     HostParticles h;
     sim->download(h);
     const double e0 = total_energy(h, fluid_mass, ibp_mass);

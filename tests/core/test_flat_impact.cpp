@@ -21,7 +21,8 @@ TEST_CASE("a block dropped flat onto the floor: CFL mode retries the impact at s
     for (const Real eta_max : {Real(0.02), Real(default_eta_max(setup.params.solver.eta))}) {
         CAPTURE(eta_max);
         setup.params.solver.eta_max = eta_max;
-        auto sim = create_openmp_simulation(setup, 1);  // one thread: ctest runs two programs at once on 2 cores
+        const test::OneHostThread one_host_thread;
+        auto sim = create_openmp_simulation(setup, 1);
 
         // Mechanical energy E = KE + Σ m g y. No viscosity, free-slip walls: E may only fall (the
         // impact dissipates it); E(0) is the block's potential energy at rest.

@@ -306,7 +306,8 @@ Throw throw_at(const std::string& object, Real speed, bool object_correction) {
     add_static_object_distance(probe, target, 0.02);
     const ContactField field = probe.params.boundary.static_objects[0];
     if (!object_correction) drop_object_correction(setup);
-    auto sim = create_openmp_simulation(setup, 0);
+    const test::OneHostThread one_host_thread;
+    auto sim = create_openmp_simulation(setup, 1);
     Throw result;
     HostParticles particles;
     for (int step = 0; step < 60; ++step) {
@@ -369,8 +370,9 @@ TEST_CASE("object contact: fluid settling round a static object never meets the 
     SimulationSetup without = with;
     without.params.boundary.static_objects.clear();
     without.params.boundary.static_object_distances.clear();
-    auto a = create_openmp_simulation(with, 0);
-    auto b = create_openmp_simulation(without, 0);
+    const test::OneHostThread one_host_thread;
+    auto a = create_openmp_simulation(with, 1);
+    auto b = create_openmp_simulation(without, 1);
     while (a->time() < 1.0) {
         a->step();
         b->step();
@@ -392,8 +394,9 @@ TEST_CASE("object contact: fluid thrown at a static sphere at 20 m/s meets the c
     const SimulationSetup setup = throw_setup("sphere", 20);
     SimulationSetup without = setup;
     drop_object_correction(without);
-    const HostParticles with_cpu = test::run_steps(*create_openmp_simulation(setup, 0), 28);
-    const HostParticles without_cpu = test::run_steps(*create_openmp_simulation(without, 0), 28);
+    const test::OneHostThread one_host_thread;
+    const HostParticles with_cpu = test::run_steps(*create_openmp_simulation(setup, 1), 28);
+    const HostParticles without_cpu = test::run_steps(*create_openmp_simulation(without, 1), 28);
     const double effect = test::largest_position_difference(with_cpu, without_cpu);
     MESSAGE("the object's correction moved fluid by up to " << effect << " m in 28 steps");
     CHECK(effect > 1e-3);

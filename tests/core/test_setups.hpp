@@ -8,6 +8,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "simulation/simulation.hpp"
@@ -22,6 +23,16 @@
 #include "sampling/wall_gap.hpp"
 
 namespace mw::test {
+
+// Host threads at one while it lives, then back to one per core (the OpenMP default). With a
+// simulation made on one thread too, a test runs as fast beside another test as alone: ctest runs
+// two programs at once on CI's two cores, where two teams of threads each wait on the other's.
+struct OneHostThread {
+    OneHostThread() { ::mw::openmp_backend::set_host_threads(1); }
+    ~OneHostThread() { ::mw::openmp_backend::set_host_threads(int(std::max(1u, std::thread::hardware_concurrency()))); }
+    OneHostThread(const OneHostThread&) = delete;
+    OneHostThread& operator=(const OneHostThread&) = delete;
+};
 
 // A box of fluid [block_lo, block_hi] in a domain [lo, hi] lined with Akinci walls at spacing r0/2,
 // the first layer rest_density_wall_gap() outside the faces (the fluid starts at rest density);

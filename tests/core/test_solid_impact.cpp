@@ -28,7 +28,8 @@ Impact throw_box(SolidKind kind, double density, double drop, bool correction, b
     SimulationSetup setup = test::box_thrown_onto_pool(kind, density, drop);
     setup.params.coupling.correction = correction;
     setup.params.coupling.predict_solids = prediction;
-    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    const test::OneHostThread one_host_thread;
+    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 1);
     Impact out;
     while (sim->time() < 0.2) {
         sim->step();
@@ -105,7 +106,8 @@ TEST_CASE("a heavy box of eight vertices sinks into a shallow pool with its bott
         if (setup.position[s].y < Real(0.07) + r0 / 100) bottom.push_back(s);
     REQUIRE(bottom.size() > 300);
 
-    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    const test::OneHostThread one_host_thread;
+    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 1);
     bool diverged = false;
     double top_fluid_speed = 0, top_solid_speed = 0, worst_tilt = 0;
     HostParticles p;

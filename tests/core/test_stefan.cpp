@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <thread>
 
 #include "simulation/factory.hpp"
 #include "test_setups.hpp"
@@ -32,13 +31,6 @@ constexpr double kDiffusivity = 0.08;       // m²/s: the liquid's and the solid
 constexpr double kCapacity = 4.18e6;        // J/(m³ K): the liquid's and the solid's
 constexpr double kDensity = 1000;           // kg/m³: the liquid's rest density and the solid's
 
-// Host threads at one while it lives, then back to one per core (the OpenMP default).
-struct OneHostThread {
-    OneHostThread() { ::mw::openmp_backend::set_host_threads(1); }
-    ~OneHostThread() { ::mw::openmp_backend::set_host_threads(int(std::max(1u, std::thread::hardware_concurrency()))); }
-    OneHostThread(const OneHostThread&) = delete;
-    OneHostThread& operator=(const OneHostThread&) = delete;
-};
 
 // λ of the one-phase Stefan problem: the root of λ e^{λ²} erf(λ) = St / sqrt(π) (increasing in λ).
 double stefan_lambda(double stefan) {
@@ -130,7 +122,7 @@ StefanRun run_stefan(double stefan, int layers, double dt, double time_limit) {
     // steps where something melted: a thousand short steps of 2,000 particles, each a handful of
     // parallel regions, crawl when a team of threads shares busy cores with another test (214 s
     // under ctest -j2 against 3 s alone).
-    const OneHostThread one_host_thread;
+    const test::OneHostThread one_host_thread;
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 1);
     StefanRun r;
     r.analytic = stefan_lambda(stefan);
