@@ -94,6 +94,8 @@ class Fluid final : public Module {
     // The last iteration's predicted positions and p/rho^2 (read by the coupling).
     View<const Vec3> predicted() const { return predicted_.cview(); }
     View<const Real> pressure_term() const { return pressure_term_.cview(); }
+    // The last iteration's pressure acceleration, until "integrate" has used it.
+    View<const Vec3> last_pressure_acceleration() const { return pressure_acc_.cview(); }
     // Two per-fluid-particle buffers free from the integration to the next step's PCISPH (the
     // predictions and the pressure accelerations): the moving solids' correction writes its
     // corrected state there before applying it.

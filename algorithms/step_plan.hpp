@@ -31,6 +31,8 @@ inline constexpr StageInfo kStepStages[] = {
     {"heat", "heat", "heat.enabled", "conduction among the fluid and the moving solids, in explicit sub-steps"},
     {"coupling", "coupling", "fluid and moving solids, coupling.two_way",
      "the fluid's forces on the solids' boundary particles, onto their inner particles"},
+    {"pressure_sensors", "pressure_sensors", "fluid and pressure_sensors",
+     "the fluid's normal load on each sensor's patch of wall, over its area, for stats.csv"},
     {"lsm", "solids", "moving solids",
      "lattice shape matching of the inner particles, then the mesh vertices and surface particles"},
     {"integrate", "fluid", "fluid", "symplectic Euler, then the walls' velocity-position correction"},

@@ -112,6 +112,12 @@ void print_json(const InfoFacts& f) {
                             {"particles", std::size_t(e.layers) * e.offsets.size()}});
         j["emitters"] = list;
     }
+    if (!f.setup.pressure_sensors.empty()) {
+        SceneJson list = SceneJson::array();
+        for (const PressureSensorSetup& p : f.setup.pressure_sensors)
+            list.push_back({{"name", p.name}, {"axis", p.axis}, {"side", p.side}, {"size", double(p.size)}});
+        j["pressure_sensors"] = list;
+    }
     j["scene"] = scene.resolved;
     std::printf("%s\n", j.dump(2, ' ', false, SceneJson::error_handler_t::replace).c_str());
 }
@@ -282,10 +288,18 @@ void print_coupling(const InfoFacts& f) {
         std::printf("            interface tension (Eq. 9) between the fluid and %ld object(s)\n", with_tension);
 }
 
-// Emitters (algorithms/emitter.hpp): what each releases, and when; heat conduction (docs/heat.md).
+// Emitters (algorithms/emitter.hpp): what each releases, and when; pressure sensors; heat
+// conduction (docs/heat.md).
 void print_emitters_and_heat(const InfoFacts& f) {
     const Scene& scene = f.scene;
     const FluidParams& fp = scene.params.fluid;
+    static const char* const kFaces[3][2] = {{"x min", "x max"}, {"y min", "y max"}, {"z min", "z max"}};
+    for (std::size_t k = 0; k < f.setup.pressure_sensors.size(); ++k) {
+        const PressureSensorSetup& p = f.setup.pressure_sensors[k];
+        std::printf("%s %s: the %s face, %g m square at [%g, %g, %g] (stats.csv sensor_%s, Pa)\n",
+                    k ? "           " : "sensors    ", p.name.c_str(), kFaces[p.axis][p.side > 0 ? 1 : 0],
+                    double(p.size), double(p.center.x), double(p.center.y), double(p.center.z), p.name.c_str());
+    }
     for (std::size_t k = 0; k < f.setup.emitters.size(); ++k) {
         const EmitterSetup& e = f.setup.emitters[k];
         const double interval = double(fp.spacing) / double(e.speed);

@@ -189,6 +189,8 @@ std::vector<ParamDoc> keys_read_by_hand() {
         {"objects[].name", "string", "\"object<i>\"", "letters, digits, _ and -; unique", "",
          "names the object's output files"},
         {"emitters[].name", "string", "\"emitter<i>\"", "letters, digits, _ and -; unique", "", "names it in info"},
+        {"pressure_sensors[].name", "string", "\"sensor<i>\"", "letters, digits, _ and -; unique", "",
+         "its stats.csv column is sensor_<name>, in Pa"},
     };
 }
 
@@ -411,6 +413,42 @@ void read_emitters(Section& root, Scene& scene) {
     });
 }
 
+// A sensor sits on the domain face nearest its centre, within r0/2 of it, and its patch lies
+// within that face.
+void read_pressure_sensors(Section& root, Scene& scene) {
+    root.array_of_objects("pressure_sensors", [&](Section& s, int index) {
+        if (index >= 64) s.fail(s.path(), "at most 64 pressure sensors are supported");
+        ScenePressureSensor p;
+        p.name = read_unique_name(s, "sensor" + std::to_string(index), scene.pressure_sensors, "pressure sensors", "");
+        s.read(pressure_sensor_keys(), static_cast<PressureSensorParams&>(p));
+        const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
+        const double c[3] = {p.center.x, p.center.y, p.center.z}, low[3] = {lo.x, lo.y, lo.z},
+                     high[3] = {hi.x, hi.y, hi.z};
+        double nearest = 1e300;
+        for (int a = 0; a < 3; ++a)
+            for (int side : {-1, 1}) {
+                const double distance = std::abs(c[a] - (side < 0 ? low[a] : high[a]));
+                if (distance < nearest) {
+                    nearest = distance;
+                    p.axis = a;
+                    p.side = side;
+                }
+            }
+        const double r0 = double(scene.params.fluid.spacing);
+        if (nearest > 0.5 * r0 * (1 + 1e-6))
+            s.fail(s.key_path("center"), "must lie on a face of the domain " + describe_box(lo, hi) +
+                                             " (within r0/2 of it): " + describe_point(p.center) + " is " +
+                                             format_scene_number(nearest) + " m from the nearest");
+        const double half = 0.5 * double(p.size);
+        for (int a = 0; a < 3; ++a)
+            if (a != p.axis && (c[a] - half < low[a] - 1e-9 || c[a] + half > high[a] + 1e-9))
+                s.fail(s.key_path("size"), "the patch (centre " + describe_point(p.center) + ", side " +
+                                               format_scene_number(double(p.size)) + ") reaches past its face of the domain " +
+                                               describe_box(lo, hi));
+        scene.pressure_sensors.push_back(p);
+    });
+}
+
 void read_output(Section s, Scene& scene) {
     s.read(scene_keys(), scene);
     for (const char* part : {"surface", "preview"}) {
@@ -482,6 +520,8 @@ std::vector<ParamDoc> scene_schema() {
     add_rows(rows, scene_keys(), "run");
     rows.push_back(by_hand[2]);
     add_rows(rows, emitter_keys(), "emitters[]");
+    rows.push_back(by_hand[3]);
+    add_rows(rows, pressure_sensor_keys(), "pressure_sensors[]");
     add_rows(rows, scene_keys(), "output");
     add_rows(rows, scene_keys(), "output.surface");
     add_rows(rows, scene_keys(), "output.preview");
@@ -551,6 +591,7 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     root.array_of_objects("objects", [&](Section& s, int index) { read_object(s, index, scene); });
     read_module(root.object("run"), scene, scene_keys(), scene);
     read_emitters(root, scene);
+    read_pressure_sensors(root, scene);
     if (scene.fluid_blocks.empty() && scene.objects.empty() && scene.emitters.empty()) {
         const std::string hint = root.misspelling_hint("fluid_blocks");
         root.fail("fluid_blocks", "at least one fluid block (or one object, or one emitter) is needed" +

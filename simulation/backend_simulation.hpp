@@ -13,6 +13,7 @@
 
 #include "algorithms/boundary_volumes.hpp"
 #include "algorithms/emitter.hpp"
+#include "algorithms/pressure_sensors.hpp"
 #include "algorithms/fluid.hpp"
 #include "algorithms/heat.hpp"
 #include "algorithms/interface_tension.hpp"
@@ -254,6 +255,7 @@ void BackendSimulation<Kernel>::build_modules(const SimulationSetup& setup, cons
                                               InterfaceTension<Kernel>::needed(has_fluid, solids));
     add<InterfaceTension<Kernel>>(state_, volumes, fluid, solids);
     add<TwoWayCoupling<Kernel>>(state_, volumes, fluid, solids, search.uses_lists());
+    add<PressureSensors<Kernel>>(state_, volumes, fluid, walls, setup, search.uses_lists());
     add<SolidCorrection<Kernel>>(state_, fluid, solids, walls);
     SurfaceField<Kernel>& surface = add<SurfaceField<Kernel>>(state_, search);
     add<Statistics<Kernel>>(state_, solids);

@@ -16,6 +16,7 @@
 #include "algorithms/heat_params.hpp"
 #include "algorithms/neighbor_params.hpp"
 #include "algorithms/particle_types.hpp"
+#include "algorithms/pressure_sensor_params.hpp"
 #include "algorithms/solid_params.hpp"
 #include "algorithms/sph_kernels.hpp"
 #include "algorithms/state_archive.hpp"
@@ -81,6 +82,14 @@ struct EmitterSetup : EmitterParams {
     std::uint32_t first = 0;    // index of its first particle in the setup's lists
 };
 
+// A pressure sensor (pressure_sensors.hpp): a square patch of the domain's face normal to `axis`,
+// its low face (side -1) or its high face (side +1).
+struct PressureSensorSetup : PressureSensorParams {
+    std::string name;
+    int axis = 0;
+    int side = -1;
+};
+
 // Initial particles, every type in one list (the store keeps one list too).
 struct SimulationSetup {
     SimulationParams params;
@@ -92,6 +101,7 @@ struct SimulationSetup {
     std::vector<std::int32_t> object;
     std::vector<SolidSetup> solids;
     std::vector<EmitterSetup> emitters;
+    std::vector<PressureSensorSetup> pressure_sensors;
     // Initial temperature of every particle, °C (any consistent unit), with params.heat only:
     // empty otherwise.
     std::vector<Real> temperature;

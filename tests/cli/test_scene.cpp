@@ -227,6 +227,17 @@ TEST_CASE("bad scenes give one line naming the key") {
         {"interface tension on a static object",
          tiny_scene_text(R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "kind": "static", "interface_tension": 0.2}])"),
          {}, {"objects[0].interface_tension", "elastic and rigid", "static"}},
+        {"a pressure sensor off the walls", tiny_scene_text(R"("pressure_sensors": [{"center": [0.1, 0.05, 0.1]}])"), {},
+         {"pressure_sensors[0].center", "face of the domain", "0.05"}},
+        {"a pressure sensor past its face", tiny_scene_text(R"("pressure_sensors": [{"center": [0.2, 0.01, 0.1], "size": 0.04}])"),
+         {}, {"pressure_sensors[0].size", "reaches past"}},
+        {"a pressure sensor of no size", tiny_scene_text(R"("pressure_sensors": [{"center": [0.2, 0.05, 0.1], "size": 0}])"), {},
+         {"pressure_sensors[0].size", "> 0"}},
+        {"two pressure sensors of one name",
+         tiny_scene_text(R"("pressure_sensors": [{"name": "p", "center": [0.2, 0.05, 0.1]}, {"name": "p", "center": [0, 0.05, 0.1]}])"),
+         {}, {"pressure_sensors[1].name", "two pressure sensors"}},
+        {"a pressure sensor's unknown key", tiny_scene_text(R"("pressure_sensors": [{"center": [0.2, 0.05, 0.1], "diameter": 0.01}])"),
+         {}, {"pressure_sensors[0].diameter", "unknown key"}},
     };
     for (const Case& c : cases) {
         CAPTURE(c.what);
