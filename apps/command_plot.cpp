@@ -174,6 +174,17 @@ void add_count_panel(std::vector<plot::Panel>& panels, const StatsTable& stats, 
     if (!panel.series.empty()) panels.push_back(panel);
 }
 
+// The pressure sensors' readings (stats.csv sensor_NAME, Pa), one line each: only where the scene
+// has sensors. The palette has seven colours: further sensors are left to the CSV.
+void add_sensor_panel(std::vector<plot::Panel>& panels, const StatsTable& stats, const std::string& empty_text) {
+    plot::Panel panel = make_panel("wall pressure at the sensors (kPa)", empty_text);
+    int shown = 0;
+    for (const std::string& name : stats.names)
+        if (name.rfind("sensor_", 0) == 0 && shown < 7)
+            add_series(panel, stats, name, name.substr(7), plot::palette(shown++), 1e-3);
+    if (!panel.series.empty()) panels.push_back(panel);
+}
+
 std::vector<plot::Panel> make_panels(const StatsTable& stats) {
     const std::string empty = stats.rows() == 0 ? "no steps" : "no data";
     std::vector<plot::Panel> panels;
@@ -196,6 +207,7 @@ std::vector<plot::Panel> make_panels(const StatsTable& stats) {
         panels.push_back(make_panel("heat content (J)", empty));
         add_series(panels.back(), stats, "heat_content", "", plot::palette(1));
     }
+    add_sensor_panel(panels, stats, empty);
     add_count_panel(panels, stats, empty);
     return panels;
 }

@@ -205,6 +205,25 @@ TEST_CASE("plot command: a real short run's picture has the requested size and a
     CHECK(decode_png(slurp(scratch_dir() + "/elsewhere.png")).width == 1500);
 }
 
+TEST_CASE("plot command: a run with pressure sensors gets a panel of their readings") {
+    using namespace cli_test;
+    const std::string dir = out_dir("plotted_sensors");
+    const std::string scene = scene_file(
+        "tiny_sensors.json",
+        tiny_scene_text(R"("pressure_sensors": [{"name": "floor", "center": [0.05, 0, 0.05], "size": 0.04}])"));
+    const Result ran = run("run " + scene + " --steps 15 --quiet --out " + dir);
+    CAPTURE(ran.err);
+    REQUIRE(ran.code == 0);
+    const Result r = run("plot " + dir + " --width 900 --height 880");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    const Decoded d = decode_png(slurp(dir + "/plot.png"));
+    // Seven panels, two columns of four: the sensors' is the seventh, alone on the last row.
+    const int top = 50, cell_w = d.width / 2, cell_h = (d.height - top - 20) / 4;
+    CHECK(count_colour(d, plot::palette(0), 0, top + 3 * cell_h, cell_w, top + 4 * cell_h) > 30);
+    CHECK(count_colour(d, plot::palette(0), cell_w, top + 3 * cell_h, d.width, top + 4 * cell_h) == 0);
+}
+
 TEST_CASE("plot command: one row, no rows, gaps and blow-ups still draw") {
     using namespace cli_test;
     const std::string one = run_dir_with("one_row", std::string(kHeader) + "1,0.001,0.001,3,1e-4,2e-3,0.1,0.5,0,0,0,0,1.5,2.5,4.2\n");
