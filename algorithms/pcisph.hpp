@@ -188,13 +188,19 @@ void pressure_acceleration(const DeviceContext& device, Neighbors neighbors, std
 
 // Symplectic Euler: v += Δt (a_np + a_p); x += Δt v; then the velocity–position correction
 // against the domain walls, the static boxes and static objects (wall_contact.hpp).
+// One particle's step: x and v at the step's start in, at its end out (the pressure sensors
+// repeat it to read what the walls' correction takes; pressure_sensors.hpp).
+MW_INLINE void integrate_particle(Vec3& x, Vec3& v, Vec3 acceleration, Real dt, const WallContact& walls) {
+    v = v + dt * acceleration;
+    x = x + dt * v;
+    walls.correct(x, v);
+}
+
 inline void integrate_fluid(const DeviceContext& device, std::size_t fluid_count, View<Vec3> position, View<Vec3> velocity, const Vec3* nonpressure,
                             View<const Vec3> pressure_acc, Vec3 gravity, Real dt, WallContact walls) {
     parallel_for(device, "integrate_fluid", fluid_count, [=] MW_HD(std::size_t i) {
-        const Vec3 a = (nonpressure ? nonpressure[i] : gravity) + pressure_acc[i];
-        Vec3 v = velocity[i] + dt * a;
-        Vec3 x = position[i] + dt * v;
-        walls.correct(x, v);
+        Vec3 x = position[i], v = velocity[i];
+        integrate_particle(x, v, (nonpressure ? nonpressure[i] : gravity) + pressure_acc[i], dt, walls);
         velocity[i] = v;
         position[i] = x;
     });

@@ -110,16 +110,16 @@ class PressureSensors final : public Module {
                     const Vec3 r = predicted[i] - xb;
                     pressure_sum += pressure_term[i] * c.kernel.grad_W_r2(r, norm2(r));
                 }
-                // The walls' correction after the integration ("integrate", the same arithmetic) takes
-                // the velocity into the wall away: that momentum is load too. Each wall particle takes
-                // the share V_b W_ib / Σ_b' V_b' W_ib' of it, so the wall as a whole takes all of it.
+                // The walls' correction in "integrate" takes the velocity into the wall away: that
+                // momentum is load too. Each wall particle takes the share V_b W_ib / Σ_b' V_b' W_ib'
+                // of it, so the wall as a whole takes all of it. (Recomputed for each wall particle
+                // the fluid particle is near: a handful, and only at a sensor.)
                 const Real w = c.kernel.W_r2(norm2(position[i] - xb));
                 if (!(w > Real(0))) return;
-                Vec3 v = velocity[i] + dt * ((nonpressure ? nonpressure[i] : c.gravity) + pressure_acc[i]);
-                Vec3 x = position[i] + dt * v;
-                const Vec3 free = v;
-                walls.correct(x, v);
-                const Vec3 dv = v - free;
+                const Vec3 a = (nonpressure ? nonpressure[i] : c.gravity) + pressure_acc[i];
+                Vec3 x = position[i], v = velocity[i];
+                integrate_particle(x, v, a, dt, walls);
+                const Vec3 dv = v - (velocity[i] + dt * a);
                 if (dv.x == Real(0) && dv.y == Real(0) && dv.z == Real(0)) return;
                 Real wall_sum = 0;
                 grid.for_each_static(position[i], [&](std::uint32_t o) {

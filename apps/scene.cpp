@@ -418,7 +418,7 @@ void read_emitters(Section& root, Scene& scene) {
 void read_pressure_sensors(Section& root, Scene& scene) {
     root.array_of_objects("pressure_sensors", [&](Section& s, int index) {
         if (index >= 64) s.fail(s.path(), "at most 64 pressure sensors are supported");
-        ScenePressureSensor p;
+        PressureSensorSetup p;
         p.name = read_unique_name(s, "sensor" + std::to_string(index), scene.pressure_sensors, "pressure sensors", "");
         s.read(pressure_sensor_keys(), static_cast<PressureSensorParams&>(p));
         const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;

@@ -48,13 +48,6 @@ struct SceneEmitter : EmitterParams {
     std::string name;
 };
 
-// A pressure sensor on a domain wall (docs/scenes.md, "pressure_sensors"; algorithms/pressure_sensors.hpp).
-struct ScenePressureSensor : PressureSensorParams {
-    std::string name;
-    int axis = 0;   // the face's normal axis
-    int side = -1;  // -1: the domain's low face on that axis, +1: its high face
-};
-
 // output.formats as flags: what each frame writes (apps/frame_writer.hpp).
 struct FrameFormats {
     bool vtu = false;      // particles as VTK XML (ParaView)
@@ -99,7 +92,7 @@ struct Scene {
     std::vector<StaticBox> static_boxes;
     std::vector<SceneObject> objects;
     std::vector<SceneEmitter> emitters;
-    std::vector<ScenePressureSensor> pressure_sensors;
+    std::vector<PressureSensorSetup> pressure_sensors;  // docs/scenes.md, "Pressure sensors"
     std::string base_dir;  // folder of the scene file ("" for text scenes): mesh paths are relative to it
     double end_time = 1.0;  // run.end_time, s
     double fps = 30;        // output.fps: frames per simulated second

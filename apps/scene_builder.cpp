@@ -318,14 +318,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     }
     if (carved_fluid) *carved_fluid = carved;
     add_emitters(scene, setup);
-    for (const ScenePressureSensor& p : scene.pressure_sensors) {
-        PressureSensorSetup sensor;
-        static_cast<PressureSensorParams&>(sensor) = p;
-        sensor.name = p.name;
-        sensor.axis = p.axis;
-        sensor.side = p.side;
-        setup.pressure_sensors.push_back(sensor);
-    }
+    setup.pressure_sensors = scene.pressure_sensors;
     return setup;
 }
 

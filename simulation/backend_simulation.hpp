@@ -13,7 +13,6 @@
 
 #include "algorithms/boundary_volumes.hpp"
 #include "algorithms/emitter.hpp"
-#include "algorithms/pressure_sensors.hpp"
 #include "algorithms/fluid.hpp"
 #include "algorithms/heat.hpp"
 #include "algorithms/interface_tension.hpp"
@@ -21,6 +20,7 @@
 #include "algorithms/module.hpp"
 #include "algorithms/neighbor_search.hpp"
 #include "algorithms/pcisph_delta.hpp"
+#include "algorithms/pressure_sensors.hpp"
 #include "algorithms/solid_bodies.hpp"
 #include "algorithms/solid_correction.hpp"
 #include "algorithms/statistics.hpp"

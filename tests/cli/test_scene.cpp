@@ -254,6 +254,11 @@ TEST_CASE("arrays of blocks, boxes and objects are capped") {
     for (int i = 0; i < 10001; ++i) blocks += std::string(i ? "," : "") + R"({"min":[0,0,0],"max":[0.1,0.1,0.1]})";
     const std::string message = parse_error(tiny_scene_text(), {"fluid_blocks=[" + blocks + "]"});
     CHECK(contains(message, "at most 10000"));
+    std::string sensors;
+    for (int i = 0; i < 65; ++i) sensors += std::string(i ? "," : "") + R"({"center":[0.2,0.05,0.1]})";
+    const std::string too_many = parse_error(tiny_scene_text(), {"pressure_sensors=[" + sensors + "]"});
+    CHECK(contains(too_many, "pressure_sensors[64]"));
+    CHECK(contains(too_many, "at most 64"));
 }
 
 TEST_CASE("touching fluid blocks and a box beside the fluid are accepted") {
