@@ -2,7 +2,7 @@
 """The speed–accuracy trade: validation cases swept over the solver's settings.
 
     make sweep                      # or: PYTHONPATH=build/python /usr/bin/python3 bench/sweep.py
-    bench/sweep.py --quick          # 47 of the 103 points, none at the finer spacing
+    bench/sweep.py --quick          # 56 of the 122 points, none at the finer spacing
     bench/sweep.py --smoke OUT      # one short point a case: checks the pipeline (a ctest)
     bench/sweep.py --replot OUT     # redraws OUT's plot and report from its sweep.csv
 
@@ -27,9 +27,18 @@ Cases:
   their Table 6 at τ = 0.56 … 1.84.
 - floating: a rigid box (0.16 × 0.08 × 0.16 m) at ρs/ρf = 0.5 set into a pool at its Archimedes
   draft, 3 s. Error: the draft's deviation from Archimedes', averaged over every step of the last
-  1 s (draft: the pool's level far from the box, less the box's lowest particle; the level: the
-  median over r0-wide columns of each column's highest particle, plus r0/2). floating_0.3 and
-  floating_0.9: the same at those ratios, at the defaults and the other spacings only.
+  1 s. The draft: the pool's level less the bottom face of the box's mesh; the level: where the
+  fluid, at the volume its lattice started with (r0³ a particle), fills the pool round the box's
+  submerged part (an incompressible pool of that fluid). Also reported: the draft from two other
+  levels, the median over r0-wide columns away from the box of each column's highest particle
+  plus r0/2 (`draft_by_tops`), and where the interior's pressure, fitted to a line, falls to 0
+  (`draft_by_pressure`). floating_0.3 and floating_0.9: the same at those ratios, at the
+  defaults and the other spacings only.
+- held_box: the floating box's pool with the box held still (every particle pinned) where
+  Archimedes puts it at ρs/ρf = 0.5, 2 s: the fluid's lift on it against ρ0 g times the volume below
+  the level (by volume, as for floating), averaged over every step of the last 0.5 s. It isolates
+  the boundary's response from the box's motion; also reported: the excess lift as a head of
+  water, in r0.
 - stefan: tests/core/test_stefan.cpp's slab at St 0.3 as a scene (a pinned lattice plate held at
   T_m + 10 K, a pinned slab of solid at T_m, no gravity, α 0.08 m²/s, 8 x 8 lattice columns). Error:
   λ fitted to the steps at which the 4 x 4 central columns' mean melted count passes each whole
@@ -231,6 +240,39 @@ def floating_scene(r0, ratio=0.5):
     }
 
 
+POOL_AREA, BOX_FOOTPRINT = 0.4 * 0.4, 0.16 * 0.16
+
+
+def box_levels(meltwater, sim, r0):
+    """The floating and held box's pool, this step: the box's bottom face and three measures of the level."""
+    import numpy as np
+
+    pos, kind = sim.position, sim.type
+    is_fluid = kind == meltwater.FLUID
+    fluid = pos[is_fluid]
+    # The bottom face: the lowest vertex of the box's mesh (its SBPs sit inside the faces).
+    bottom = float(pos[(sim.object == 0) & (kind == meltwater.GEOMETRY), 1].min())
+    # By volume: the level at which the fluid, at the volume its lattice started with (r0³ a
+    # particle), fills the pool round the box's submerged part.
+    volume = (len(fluid) * r0**3 - BOX_FOOTPRINT * bottom) / (POOL_AREA - BOX_FOOTPRINT)
+    # By the surface particles, away from the box: the median over r0-wide columns of each
+    # column's highest particle, plus r0/2 (a splash's droplets do not move it).
+    far_mask = (np.abs(fluid[:, 0] - 0.2) > 0.13) | (np.abs(fluid[:, 2] - 0.2) > 0.13)
+    far = fluid[far_mask]
+    column = np.floor(far[:, 0] / r0).astype(int) * 100000 + np.floor(far[:, 2] / r0).astype(int)
+    order = np.lexsort((far[:, 1], column))
+    last = np.r_[column[order][1:] != column[order][:-1], True]
+    tops = float(np.median(far[order][last, 1])) + r0 / 2
+    # By pressure: where a line fitted to the pressures away from the box, the walls, the floor and
+    # the surface falls to 0.
+    p = sim.pressure[is_fluid]
+    inner = far_mask & (fluid[:, 0] > 2 * r0) & (fluid[:, 0] < 0.4 - 2 * r0) & (fluid[:, 2] > 2 * r0) & \
+        (fluid[:, 2] < 0.4 - 2 * r0) & (fluid[:, 1] > 3 * r0) & (fluid[:, 1] < bottom - 2 * r0)
+    slope, intercept = np.polyfit(fluid[inner, 1], p[inner], 1) if inner.sum() > 10 else (0.0, 0.0)
+    pressure = -intercept / slope if slope < 0 else float("nan")
+    return bottom, volume, tops, pressure
+
+
 def floating_measure(meltwater, sim, r0, settle, ratio=0.5):
     import numpy as np
 
@@ -240,20 +282,37 @@ def floating_measure(meltwater, sim, r0, settle, ratio=0.5):
     drafts = []
     while sim.time < settle:
         sim.step()
-        pos, kind = sim.position, sim.type
-        fluid = pos[kind == meltwater.FLUID]
-        far = fluid[(np.abs(fluid[:, 0] - 0.2) > 0.13) | (np.abs(fluid[:, 2] - 0.2) > 0.13)]
-        # The level: the median over r0-wide columns of each column's highest particle, plus r0/2;
-        # a splash's droplets do not move it.
-        column = np.floor(far[:, 0] / r0).astype(int) * 100000 + np.floor(far[:, 2] / r0).astype(int)
-        order = np.lexsort((far[:, 1], column))
-        last = np.r_[column[order][1:] != column[order][:-1], True]
-        level = float(np.median(far[order][last, 1])) + r0 / 2
-        bottom = float(pos[(sim.object == 0) & (kind != meltwater.GEOMETRY), 1].min())
-        drafts.append(level - bottom)
-    draft = float(np.mean(drafts))
+        bottom, volume, tops, pressure = box_levels(meltwater, sim, r0)
+        drafts.append((volume - bottom, tops - bottom, pressure - bottom))
+    draft, by_tops, by_pressure = (float(v) for v in np.nanmean(np.array(drafts), axis=0))
     return {"error": abs(draft - archimedes) / archimedes, "draft": draft, "archimedes": archimedes,
-            "draft_swing": float(np.ptp(drafts))}
+            "draft_swing": float(np.ptp([d[0] for d in drafts])), "draft_by_tops": by_tops,
+            "draft_by_pressure": by_pressure}
+
+
+def held_box_scene(r0):
+    scene = floating_scene(r0, 0.5)
+    box = scene["objects"][0]
+    box["kind"] = "elastic"  # a rigid object cannot be pinned; a pinned lattice does not move
+    box["pinned"] = {"box": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]}}
+    return scene
+
+
+def held_box_measure(meltwater, sim, r0, settle):
+    import numpy as np
+
+    sim.run(until=settle - min(0.5, settle / 2))
+    lifts, depths = [], []
+    while sim.time < settle:
+        sim.step()
+        bottom, volume, _, _ = box_levels(meltwater, sim, r0)
+        lifts.append(float(np.asarray(sim.fluid_force_on_solids())[0, 1]))
+        depths.append(volume - bottom)
+    rho_g = 1000 * 9.81
+    lift, depth = float(np.mean(lifts)), float(np.mean(depths))
+    archimedes = rho_g * BOX_FOOTPRINT * depth
+    return {"error": abs(lift / archimedes - 1), "lift_ratio": lift / archimedes, "depth": depth,
+            "excess_head_r0": (lift / (rho_g * BOX_FOOTPRINT) - depth) / r0}
 
 
 def stefan_scene(r0, stefan=0.3, layers=10):
@@ -334,6 +393,7 @@ CASES = {
     # The same box at other density ratios, over the spacings only (applies()).
     "floating_0.3": (lambda r0: floating_scene(r0, 0.3), lambda *a: floating_measure(*a, ratio=0.3), 0.02, 3.0),
     "floating_0.9": (lambda r0: floating_scene(r0, 0.9), lambda *a: floating_measure(*a, ratio=0.9), 0.02, 3.0),
+    "held_box": (held_box_scene, held_box_measure, 0.02, 2.0),
     "stefan": (stefan_scene, stefan_measure, 0.02, None),
     "lobovsky": (lobovsky_scene, lobovsky_measure, 0.01, None),
 }
@@ -382,7 +442,7 @@ def applies(case, change):
         return not change or set(change) == {"r0_factor"}
     if "r0_factor" in change and len(change) > 1:
         return case in ("dam_break", "lobovsky")
-    return not ("coupling.correction" in change and case != "floating")
+    return not ("coupling.correction" in change and case not in ("floating", "held_box"))
 
 
 # ---- one point, in its own process ----------------------------------------------------------------
@@ -400,7 +460,7 @@ def run_point(spec):
     if h_factor:
         change["fluid.support_radius"] = h_factor * r0
     if spec.get("smoke"):
-        seconds = 0.4 if spec["case"].startswith("floating") else {"stefan": 0.2}.get(spec["case"], 0.1)
+        seconds = 0.4 if spec["case"].startswith("floating") or spec["case"] == "held_box" else {"stefan": 0.2}.get(spec["case"], 0.1)
     out = {"status": "ok"}
     started = time.monotonic()
     try:
