@@ -293,7 +293,7 @@ def floating_measure(meltwater, sim, r0, settle, ratio=0.5):
 def held_box_scene(r0):
     scene = floating_scene(r0, 0.5)
     box = scene["objects"][0]
-    box["kind"] = "elastic"  # a rigid object cannot be pinned; a pinned lattice does not move
+    box["kind"] = "elastic"  # every IBP pinned: the lattice, and the mesh and SBPs on it, never move
     box["pinned"] = {"box": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]}}
     return scene
 
