@@ -226,21 +226,25 @@ def lobovsky_measure(meltwater, sim, r0, settle):
             "peak": loads[k], "peak_at": times[k], "impulse": impulse}
 
 
+# The floating and held box's pool: a square tank POOL wide, water POOL_DEPTH deep, the box BOX_WIDTH
+# square and BOX_HEIGHT tall at its centre.
+POOL, POOL_DEPTH, BOX_WIDTH, BOX_HEIGHT = 0.4, 0.2, 0.16, 0.08
+POOL_AREA, BOX_FOOTPRINT = POOL * POOL, BOX_WIDTH * BOX_WIDTH
+
+
 def floating_scene(r0, ratio=0.5):
-    # The box's centre where its bottom sits at Archimedes' draft below the 0.2 m surface.
-    draft = ratio * 0.08
+    # The box's centre where its bottom sits at Archimedes' draft below the surface.
+    draft = ratio * BOX_HEIGHT
+    centre = POOL / 2
     return {
         "name": "sweep_floating",
-        "domain": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]},
+        "domain": {"min": [0, 0, 0], "max": [POOL, POOL, POOL]},
         "fluid": {"rest_density": 1000, "spacing": r0, "viscosity": 0.01},
-        "fluid_blocks": [{"min": [0, 0, 0], "max": [0.4, 0.2, 0.4]}],
-        "objects": [{"name": "box", "mesh": {"procedural": "box:x=0.16,y=0.08,z=0.16"},
-                     "transform": {"translation": [0.2, 0.2 - draft + 0.04, 0.2]}, "kind": "rigid",
-                     "density": 1000 * ratio}],
+        "fluid_blocks": [{"min": [0, 0, 0], "max": [POOL, POOL_DEPTH, POOL]}],
+        "objects": [{"name": "box", "mesh": {"procedural": f"box:x={BOX_WIDTH},y={BOX_HEIGHT},z={BOX_WIDTH}"},
+                     "transform": {"translation": [centre, POOL_DEPTH - draft + BOX_HEIGHT / 2, centre]},
+                     "kind": "rigid", "density": 1000 * ratio}],
     }
-
-
-POOL_AREA, BOX_FOOTPRINT = 0.4 * 0.4, 0.16 * 0.16
 
 
 def box_levels(meltwater, sim, r0):
@@ -250,14 +254,17 @@ def box_levels(meltwater, sim, r0):
     pos, kind = sim.position, sim.type
     is_fluid = kind == meltwater.FLUID
     fluid = pos[is_fluid]
-    # The bottom face: the lowest vertex of the box's mesh (its SBPs sit inside the faces).
+    # The bottom face: the lowest vertex of the box's mesh, the face itself, wherever the box's
+    # particles sit about it.
     bottom = float(pos[(sim.object == 0) & (kind == meltwater.GEOMETRY), 1].min())
     # By volume: the level at which the fluid, at the volume its lattice started with (r0³ a
     # particle), fills the pool round the box's submerged part.
     volume = (len(fluid) * r0**3 - BOX_FOOTPRINT * bottom) / (POOL_AREA - BOX_FOOTPRINT)
     # By the surface particles, away from the box: the median over r0-wide columns of each
     # column's highest particle, plus r0/2 (a splash's droplets do not move it).
-    far_mask = (np.abs(fluid[:, 0] - 0.2) > 0.13) | (np.abs(fluid[:, 2] - 0.2) > 0.13)
+    # Away from the box: 0.05 m (the box's splash and meniscus) past its sides.
+    clear = BOX_WIDTH / 2 + 0.05
+    far_mask = (np.abs(fluid[:, 0] - POOL / 2) > clear) | (np.abs(fluid[:, 2] - POOL / 2) > clear)
     far = fluid[far_mask]
     column = np.floor(far[:, 0] / r0).astype(int) * 100000 + np.floor(far[:, 2] / r0).astype(int)
     order = np.lexsort((far[:, 1], column))
@@ -266,8 +273,8 @@ def box_levels(meltwater, sim, r0):
     # By pressure: where a line fitted to the pressures away from the box, the walls, the floor and
     # the surface falls to 0.
     p = sim.pressure[is_fluid]
-    inner = far_mask & (fluid[:, 0] > 2 * r0) & (fluid[:, 0] < 0.4 - 2 * r0) & (fluid[:, 2] > 2 * r0) & \
-        (fluid[:, 2] < 0.4 - 2 * r0) & (fluid[:, 1] > 3 * r0) & (fluid[:, 1] < bottom - 2 * r0)
+    inner = far_mask & (fluid[:, 0] > 2 * r0) & (fluid[:, 0] < POOL - 2 * r0) & (fluid[:, 2] > 2 * r0) & \
+        (fluid[:, 2] < POOL - 2 * r0) & (fluid[:, 1] > 3 * r0) & (fluid[:, 1] < bottom - 2 * r0)
     slope, intercept = np.polyfit(fluid[inner, 1], p[inner], 1) if inner.sum() > 10 else (0.0, 0.0)
     pressure = -intercept / slope if slope < 0 else float("nan")
     return bottom, volume, tops, pressure
@@ -276,7 +283,7 @@ def box_levels(meltwater, sim, r0):
 def floating_measure(meltwater, sim, r0, settle, ratio=0.5):
     import numpy as np
 
-    archimedes = ratio * 0.08
+    archimedes = ratio * BOX_HEIGHT
     window = min(1.0, settle / 2)
     sim.run(until=settle - window)
     drafts = []
@@ -284,7 +291,11 @@ def floating_measure(meltwater, sim, r0, settle, ratio=0.5):
         sim.step()
         bottom, volume, tops, pressure = box_levels(meltwater, sim, r0)
         drafts.append((volume - bottom, tops - bottom, pressure - bottom))
-    draft, by_tops, by_pressure = (float(v) for v in np.nanmean(np.array(drafts), axis=0))
+    table = np.array(drafts)
+    draft, by_tops = (float(v) for v in table[:, :2].mean(axis=0))
+    # No pressure level where the pool has too few interior particles to fit (r0 0.04 m).
+    finite = np.isfinite(table[:, 2])
+    by_pressure = float(table[finite, 2].mean()) if finite.any() else float("nan")
     return {"error": abs(draft - archimedes) / archimedes, "draft": draft, "archimedes": archimedes,
             "draft_swing": float(np.ptp([d[0] for d in drafts])), "draft_by_tops": by_tops,
             "draft_by_pressure": by_pressure}
@@ -294,7 +305,7 @@ def held_box_scene(r0):
     scene = floating_scene(r0, 0.5)
     box = scene["objects"][0]
     box["kind"] = "elastic"  # every IBP pinned: the lattice, and the mesh and SBPs on it, never move
-    box["pinned"] = {"box": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]}}
+    box["pinned"] = {"box": {"min": [0, 0, 0], "max": [POOL, POOL, POOL]}}
     return scene
 
 
