@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "algorithms/lsm.hpp"
 #include "algorithms/lsm_regions.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/pcisph.hpp"
@@ -94,19 +95,55 @@ struct CouplingData {
     Real inverse_dt = 0;
     // Interface tension's η per SBP (interface_tension.hpp); null: none.
     const Real* sbp_eta = nullptr;
+    // Inside PCISPH (coupling.strong): only the slots of the objects flagged here (per object,
+    // by each slot's object) are gathered; null: every slot.
+    const std::int32_t* slot_object = nullptr;
+    const std::uint8_t* gather_object = nullptr;
 };
 
 // The pairs the fluid summed: in grid mode all in the 27 cells (the relation is symmetric:
 // b is in the cells around i exactly when i is in those around b); with neighbour lists only
 // those within `list_radius` of each other at the start of the step, tested as the lists'
 // build tests them (neighbor_list.hpp). list_radius 0: grid mode.
+// With lists, each slot's pairs are listed once per step (list_slot_pairs), so that the reaction
+// gathered in every PCISPH iteration (coupling.strong) and after it walks a short row instead of
+// 27 cells: `rows` of `row_capacity` per slot, `row_count` each (kRowOverflow: the slot had more,
+// and gathers from the grid).
 struct FluidPairs {
     GridView grid;
     std::size_t fluid_end = 0, solid_end = 0;  // the moving solids' boundary particles: [fluid_end, solid_end)
     Real list_radius2 = 0;
     // Where PCISPH met the solids' particles (pcisph.hpp): the reaction meets them there too.
     SolidLookahead lookahead;
+    const std::uint32_t* rows = nullptr;
+    const std::uint32_t* row_count = nullptr;
+    std::uint32_t row_capacity = 0;
 };
+constexpr std::uint32_t kRowOverflow = 0xffffffffu;
+
+// The rows of FluidPairs (lists only): each slot's fluid neighbours within the list radius at the
+// start of the step, in the grid's order, so that a row's sums are the grid's to the bit.
+inline void list_slot_pairs(const DeviceContext& device, const FluidPairs pairs, std::size_t slot_count,
+                            const std::uint32_t* store_of_slot, View<const Vec3> position, std::uint32_t* rows,
+                            std::uint32_t* row_count) {
+    parallel_for(device, "coupling_pairs", slot_count, [=] MW_HD(std::size_t s) {
+        const std::uint32_t b = store_of_slot[s];
+        if (b < pairs.fluid_end || b >= pairs.solid_end) {
+            row_count[s] = 0;
+            return;
+        }
+        const Vec3 xb = position[b];
+        std::uint32_t* row = rows + s * pairs.row_capacity;
+        std::uint32_t n = 0;
+        pairs.grid.for_each_fluid(xb, [&](std::uint32_t i) {
+            if (norm2(position[i] - xb) < pairs.list_radius2) {
+                if (n < pairs.row_capacity) row[n] = i;
+                ++n;
+            }
+        });
+        row_count[s] = n <= pairs.row_capacity ? n : kRowOverflow;
+    });
+}
 
 template <class Kernel>
 void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pairs, const CouplingData d, View<const Vec3> position,
@@ -116,6 +153,7 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
     const Real friction_scale = -c.mass * c.wall_viscosity / c.rest_density;  // -m μ_w / ρ0
     const bool lists = pairs.list_radius2 > Real(0);
     parallel_for(device, "coupling_reaction", std::size_t(d.ibp_count) + d.sbp_count, [=] MW_HD(std::size_t s) {
+        if (d.gather_object && !d.gather_object[d.slot_object[s]]) return;
         const std::uint32_t b = d.store_of_slot[s];
         // A solid particle that left the grid (counted as lost) meets no fluid.
         if (b < pairs.fluid_end || b >= pairs.solid_end) {
@@ -125,10 +163,10 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
         const Vec3 xb = position[b], vb = velocity[b];
         const Real eta = d.sbp_eta && s >= d.ibp_count ? d.sbp_eta[s - d.ibp_count] : Real(0);
         Vec3 pressure_sum{0, 0, 0}, friction_sum{0, 0, 0}, tension_sum{0, 0, 0};
-        pairs.grid.for_each_fluid(xb, [&](std::uint32_t i) {
+        const Vec3 xb_met = pairs.lookahead.place(b, xb);
+        const auto add = [&](std::uint32_t i, Real paired) {
             const Vec3 xi = position[i];
-            const Real paired = lists ? (norm2(xi - xb) < pairs.list_radius2 ? Real(1) : Real(0)) : Real(1);
-            const Vec3 r = predicted[i] - pairs.lookahead.place(b, xb);
+            const Vec3 r = predicted[i] - xb_met;
             pressure_sum += (paired * pressure_term[i]) * c.kernel.grad_W_r2(r, norm2(r));
             if (friction) friction_sum += c.kernel.laplacian_visc_r2(norm2(xi - xb)) * (vb - velocity[i]);
             if (eta > Real(0)) {
@@ -137,7 +175,16 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
                 const Real w = c.kernel.W_r2(r2);
                 if (w > Real(0) && r2 > Real(0)) tension_sum += (w / std::sqrt(r2)) * x_is;
             }
-        });
+        };
+        const std::uint32_t listed = pairs.rows ? pairs.row_count[s] : kRowOverflow;
+        if (listed != kRowOverflow) {
+            const std::uint32_t* row = pairs.rows + s * pairs.row_capacity;
+            for (std::uint32_t k = 0; k < listed; ++k) add(row[k], Real(1));
+        } else {
+            pairs.grid.for_each_fluid(xb, [&](std::uint32_t i) {
+                add(i, lists ? (norm2(position[i] - xb) < pairs.list_radius2 ? Real(1) : Real(0)) : Real(1));
+            });
+        }
         const Real vb_volume = boundary_volume[b];
         Vec3 reaction = (pressure_scale * vb_volume) * pressure_sum + (friction_scale * vb_volume) * friction_sum +
                         (pressure_scale * vb_volume * eta) * tension_sum;
@@ -150,10 +197,133 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
 // Each IBP's force: its own reaction and its shares of the SBPs' (see the top of the file).
 inline void gather_solid_forces(const DeviceContext& device, const CouplingData d) {
     parallel_for(device, "coupling_to_ibps", d.ibp_count, [=] MW_HD(std::size_t s) {
+        if (d.gather_object && !d.gather_object[d.slot_object[s]]) return;
         Vec3 f = d.reaction[s];
         for (std::uint32_t e = d.share_offsets[s]; e < d.share_offsets[s + 1]; ++e)
             f += d.share_weight[e] * d.reaction[d.ibp_count + d.share_sbp[e]];
         d.force[s] = f;
+    });
+}
+
+
+// Strong coupling (coupling.strong): rigid objects answer the fluid's pressure inside the PCISPH
+// iterations. Each iteration meets a rigid object where the step takes it under a linear and an
+// angular acceleration (SolidLookahead::object_response); the fluid's reaction at that iteration
+// gives the accelerations it implies, G = (g + F/M, I⁻¹ τ) (F and τ the fluid's force and torque
+// on the object's IBPs about its centre, the coupling's reaction gathered as above; M, I its mass
+// and inertia), and the expected accelerations move toward G. The domain's walls bound G as LSM
+// does: no object is expected to pass the box shrunk by its margin (its IBPs' extent moved at
+// its velocity), so the fluid is never asked to carry a body that rests on the floor.
+// Taken whole, a light object overshoots: the fluid it pushes weighs more than it does, so its
+// answer to its own answer grows every iteration (partitioned fluid–structure coupling's
+// added-mass instability). Aitken's Δ² relaxation (Küttler & Wall 2008) sets each object's step
+// from its last two residuals r = G - a: a += ω r,
+// ω_k = -ω_{k-1} r_{k-1}·(r_k - r_{k-1}) / |r_k - r_{k-1}|², within [kMinRelaxation, 1], from
+// kFirstRelaxation (the angular part scaled by the object's half-diagonal). Only the rigid
+// objects' particles are gathered inside PCISPH (CouplingData::gather_object).
+// Elastic objects are met at their mean velocity, without an answer: measured, the same answer
+// (their mean acceleration) left the heavy elastic cubes at CFL 1 gaining energy or running away
+// at the floor in ways that changed with any detail of the relaxation (docs/coupling.md).
+struct ObjectIbps {
+    const std::uint32_t* begin = nullptr;  // per object, its first IBP slot (and one past the last)
+    const std::uint32_t* store_of_slot = nullptr;
+    const Real* mass = nullptr;  // per IBP slot
+    const LsmObjectParams* params = nullptr;  // per object (rigid or not, its wall margin)
+    std::size_t count = 0;
+};
+struct ResponseRelaxation {
+    Vec3 linear{0, 0, 0}, angular{0, 0, 0};  // the last residual (angular scaled by the object's size)
+    Real omega = 0;                          // the last ω; 0: no update yet in this try
+};
+constexpr Real kFirstRelaxation = Real(0.5);
+constexpr Real kMinRelaxation = Real(0.01);
+
+struct ResponseStep {
+    Vec3 gravity{0, 0, 0};
+    Vec3 domain_min{0, 0, 0}, domain_max{0, 0, 0};
+    Real dt = 0;
+};
+
+// A new try: every object expected to keep its velocity.
+inline void start_object_responses(const DeviceContext& device, std::size_t object_count, ObjectResponse* response,
+                                   ResponseRelaxation* relaxation) {
+    parallel_for(device, "strong_coupling_start", object_count, [=] MW_HD(std::size_t o) {
+        response[o] = ObjectResponse{};
+        relaxation[o] = ResponseRelaxation{};
+    });
+}
+
+inline void relax_object_accelerations(const DeviceContext& device, ObjectIbps objects, View<const Vec3> position,
+                                       View<const Vec3> velocity, const Vec3* ibp_force, ResponseStep step,
+                                       const ObjectResponse* response, ObjectResponse* next,
+                                       ResponseRelaxation* relaxation) {
+    parallel_for(device, "strong_coupling_relax", objects.count, [=] MW_HD(std::size_t o) {
+        const ObjectResponse now = response[o];
+        const LsmObjectParams params = objects.params[o];
+        if (!params.rigid) {
+            next[o] = now;
+            return;
+        }
+        // Sums relative to the first IBP (float keeps the body's size, not its place).
+        std::uint32_t first = objects.begin[o];
+        while (first < objects.begin[o + 1] && objects.store_of_slot[first] == kMeltedSlot) ++first;
+        if (first == objects.begin[o + 1]) {
+            next[o] = now;
+            return;
+        }
+        const Vec3 anchor = position[objects.store_of_slot[first]];
+        BodySums body;
+        Vec3 force{0, 0, 0}, torque{0, 0, 0};  // torque about the anchor
+        Vec3 lo{0, 0, 0}, hi{0, 0, 0};          // the IBPs' extent, from the anchor
+        for (std::uint32_t s = first; s < objects.begin[o + 1]; ++s) {
+            const std::uint32_t i = objects.store_of_slot[s];
+            if (i == kMeltedSlot) continue;
+            const Vec3 r = position[i] - anchor;
+            body.add(objects.mass[s], r, velocity[i]);
+            force += ibp_force[s];
+            torque += cross(r, ibp_force[s]);
+            lo = Vec3{r.x < lo.x ? r.x : lo.x, r.y < lo.y ? r.y : lo.y, r.z < lo.z ? r.z : lo.z};
+            hi = Vec3{r.x > hi.x ? r.x : hi.x, r.y > hi.y ? r.y : hi.y, r.z > hi.z ? r.z : hi.z};
+        }
+        const BodyMotion motion = body_motion(body);
+        // G: gravity and the fluid's force, and the fluid's torque about the centre.
+        ObjectResponse target;
+        target.centre = anchor + motion.centre;
+        target.linear = step.gravity + force / body.M;
+        target.angular = motion.inverse_inertia * (torque - cross(motion.centre, force));
+        // The walls: the object's expected shift dt (V + dt G) keeps its extent inside the box.
+        const Real lo_room[3] = {step.domain_min.x + params.margin - (anchor.x + lo.x),
+                                 step.domain_min.y + params.margin - (anchor.y + lo.y),
+                                 step.domain_min.z + params.margin - (anchor.z + lo.z)};
+        const Real hi_room[3] = {step.domain_max.x - params.margin - (anchor.x + hi.x),
+                                 step.domain_max.y - params.margin - (anchor.y + hi.y),
+                                 step.domain_max.z - params.margin - (anchor.z + hi.z)};
+        const Real v[3] = {motion.velocity.x, motion.velocity.y, motion.velocity.z};
+        Real* g[3] = {&target.linear.x, &target.linear.y, &target.linear.z};
+        const Real inverse_dt2 = Real(1) / (step.dt * step.dt);
+        for (int k = 0; k < 3; ++k) {
+            const Real shift = step.dt * v[k] + step.dt * step.dt * *g[k];
+            if (shift < lo_room[k]) *g[k] = (lo_room[k] - step.dt * v[k]) * inverse_dt2;
+            if (shift > hi_room[k]) *g[k] = (hi_room[k] - step.dt * v[k]) * inverse_dt2;
+        }
+        // Aitken over (linear, size × angular), one ω per object.
+        const Real size = Real(0.5) * norm(hi - lo);
+        const Vec3 r_linear = target.linear - now.linear, r_angular = size * (target.angular - now.angular);
+        ResponseRelaxation& state = relaxation[o];
+        Real omega = kFirstRelaxation;
+        if (state.omega > Real(0)) {
+            const Vec3 d_linear = r_linear - state.linear, d_angular = r_angular - state.angular;
+            const Real d2 = norm2(d_linear) + norm2(d_angular);
+            omega = d2 > Real(0) ? -state.omega * (dot(state.linear, d_linear) + dot(state.angular, d_angular)) / d2
+                                 : state.omega;
+            omega = omega < kMinRelaxation ? kMinRelaxation : omega > Real(1) ? Real(1) : omega;
+        }
+        state.linear = r_linear;
+        state.angular = r_angular;
+        state.omega = omega;
+        next[o].linear = now.linear + omega * (target.linear - now.linear);
+        next[o].angular = now.angular + omega * (target.angular - now.angular);
+        next[o].centre = target.centre;
     });
 }
 

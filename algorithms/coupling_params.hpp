@@ -14,6 +14,9 @@ struct CouplingParams {
     Real slip = 1;  // the correction's tangential rule: 1 free slip, 0 no slip
     // PCISPH meets the moving solids' boundary particles where they will be at the end of the step.
     bool predict_solids = true;
+    // Rigid objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids):
+    // each iteration meets them where gravity and the last iterations' pressure take them.
+    bool strong = true;
 };
 
 inline const ParamTable<CouplingParams>& coupling_keys() {
@@ -28,6 +31,8 @@ inline const ParamTable<CouplingParams>& coupling_keys() {
                                   "the correction's tangential rule: 1 free slip, 0 no slip"));
         t.push_back(boolean_key<T>("coupling", "predict_solids", member(&T::predict_solids),
                                    "PCISPH meets the objects where the step will take them, not where they start it"));
+        t.push_back(boolean_key<T>("coupling", "strong", member(&T::strong),
+                                   "rigid objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids)"));
         return t;
     }();
     return table;

@@ -127,6 +127,7 @@ class Fluid final : public Module {
         while (iterations < solver.max_iterations) {
             // The first prediction has no pressure acceleration yet (nothing to clear beforehand).
             const bool first = iterations == 0;
+            if (step.pressure_response) step.pressure_response->before_iteration(step, dt, iterations);
             predict_positions(device, fluid_count, store.position.cview(), store.velocity.cview(), step.nonpressure,
                               first ? nullptr : pressure_acc_.view().data(), predicted_.view(), fluid.gravity, dt,
                               walls_.walls(), step.solid_surface);

@@ -35,6 +35,18 @@ struct Neighborhood {
     }
 };
 
+struct StepContext;
+// What answers the fluid's pressure inside the PCISPH iterations (coupling.strong,
+// two_way_coupling.hpp): called before each iteration's prediction, with the previous iteration's
+// predictions and pressures still in place (iteration 0: a new try of the step, at `dt`).
+class PressureResponse {
+   public:
+    virtual void before_iteration(StepContext& step, Real dt, int iteration) = 0;
+
+   protected:
+    ~PressureResponse() = default;
+};
+
 // What one step's stages hand each other, in the order they run.
 struct StepContext {
     double time = 0;     // the simulated time at the step's start, s
@@ -46,6 +58,7 @@ struct StepContext {
     const Vec3* nonpressure = nullptr;
     SolidSurface solid_surface;  // the moving solids' surface for their correction (inactive without it)
     SolidLookahead lookahead;    // where PCISPH meets the moving solids' boundary particles
+    PressureResponse* pressure_response = nullptr;  // the solids' answer inside PCISPH (null: none)
     int iterations = 0;          // PCISPH iterations, over every try of the step
     int retries = 0;             // the step's halvings
     PcisphOutcome outcome = PcisphOutcome::kConverged;

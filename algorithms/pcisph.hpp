@@ -113,18 +113,35 @@ inline void predict_positions(const DeviceContext& device, std::size_t fluid_cou
 // velocity, since its own carries the object's vibration, which the fluid's pressure would answer
 // (the floating jelly's pool ran three times as fast; docs/coupling.md, "Solids met where they
 // will be"). Static boundary particles stay put.
+// A rigid object's expected acceleration in the step: linear, and angular about its centre
+// (coupling.hpp, relax_object_accelerations).
+struct ObjectResponse {
+    Vec3 linear{0, 0, 0}, angular{0, 0, 0}, centre{0, 0, 0};
+};
+
 struct SolidLookahead {
     const Vec3* velocity = nullptr;            // the store's; null: every boundary particle where it is
     const Vec3* object_velocity = nullptr;        // per object, its mean velocity
     const LsmObjectParams* objects = nullptr;     // per object: whether it is rigid
     const std::int32_t* solid_slot = nullptr;     // the store's solid_slot field (solid_bodies.hpp)
     const std::int32_t* slot_object = nullptr;    // per IBP and SBP slot, its object
+    // Per object, the accelerations the solve expects the step to give a rigid object (gravity and
+    // the fluid's pressure, coupling.strong; coupling.hpp); null: none, it keeps its velocity.
+    const ObjectResponse* object_response = nullptr;
     std::size_t end = 0;                       // the moving solids' boundary particles end here
     Real dt = 0;
     MW_INLINE Vec3 place(std::uint32_t b, Vec3 xb) const {
         if (!velocity || b >= end) return xb;
         const std::int32_t o = slot_object[solid_slot[b]];
-        return xb + dt * (objects[o].rigid ? velocity[b] : object_velocity[o]);
+        if (objects[o].rigid) {
+            Vec3 v = velocity[b];
+            if (object_response) {
+                const ObjectResponse r = object_response[o];
+                v += dt * (r.linear + cross(r.angular, xb - r.centre));
+            }
+            return xb + dt * v;
+        }
+        return xb + dt * object_velocity[o];
     }
 };
 

@@ -230,6 +230,15 @@ class SolidBodies final : public Module {
     std::size_t boundary_slot_count() const { return ibp_count_ + sbp_count_; }
 
     bool active() const { return ibp_count_ > 0; }
+    bool has_rigid() const { return has_rigid_; }
+    // Per object, 1 for a rigid one (host, for the strong coupling's gathers).
+    std::vector<std::uint8_t> rigid_objects() const {
+        std::vector<std::uint8_t> rigid;
+        for (const LsmObjectParams& o : objects_.to_host()) rigid.push_back(o.rigid ? 1 : 0);
+        return rigid;
+    }
+    Vec3 domain_min() const { return domain_min_; }
+    Vec3 domain_max() const { return domain_max_; }
     // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.
     bool coupled() const { return !force_.empty(); }
     std::size_t ibp_count() const { return ibp_count_; }
@@ -374,6 +383,17 @@ class SolidBodies final : public Module {
         std::uint32_t i = 0;
         store_of_slot_.download_range(&i, slot, 1);
         return i;
+    }
+
+    // Each object's IBP slots and their masses (the strong coupling's per-object sums).
+    ObjectIbps object_ibps() const {
+        ObjectIbps o;
+        o.begin = object_ibp_begin_.view().data();
+        o.store_of_slot = store_of_slot_.view().data();
+        o.mass = mass_.view().data();
+        o.params = objects_.view().data();
+        o.count = object_count_;
+        return o;
     }
 
     // The coupling's arrays (coupled() only); the slot map must be current.

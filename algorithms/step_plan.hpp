@@ -19,8 +19,9 @@ inline constexpr StageInfo kStepStages[] = {
     {"neighbors", "neighbor_search, solid_correction", "always",
      "sorts the moving particles by cell and permutes every field; neighbour lists (OpenMP); which fluid is near "
      "a moving solid"},
-    {"solid_volumes", "boundary_volumes, solids", "fluid and moving solids",
-     "Akinci volumes of the moving solids' boundary particles; where the solids will be at the step's end"},
+    {"solid_volumes", "boundary_volumes, solids, coupling", "fluid and moving solids",
+     "Akinci volumes of the moving solids' boundary particles; where the solids will be at the step's end; the rigid "
+     "objects' answer inside PCISPH (coupling.strong)"},
     {"viscosity", "fluid", "fluid with viscosity or wall friction",
      "gravity, viscosity (Eq. 4, mirrored across the domain walls) and wall friction (Eq. 8)"},
     {"interface_tension", "interface_tension", "fluid and an object with interface tension",

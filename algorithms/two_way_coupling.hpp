@@ -1,7 +1,11 @@
 // The two-way coupling module (stage "coupling", with fluid, moving solids and
 // coupling.two_way): every force the fluid felt from a moving solid's boundary particles in this
 // step's PCISPH goes back to the solid's inner particles (coupling.hpp), which LSM then moves.
+// With coupling.strong (and predict_solids) rigid objects also answer the pressure inside PCISPH:
+// before each iteration the last one's reaction moves each object's expected acceleration
+// (coupling.hpp, relax_object_accelerations), and the iteration meets the object there.
 #pragma once
+#include <cmath>
 #include "algorithms/boundary_volumes.hpp"
 #include "algorithms/coupling.hpp"
 #include "algorithms/fluid.hpp"
@@ -11,40 +15,121 @@
 MW_BACKEND_BEGIN
 
 template <class Kernel>
-class TwoWayCoupling final : public Module {
+class TwoWayCoupling final : public Module, public PressureResponse {
    public:
     TwoWayCoupling(SimulationState<Kernel>& state, const BoundaryVolumes<Kernel>& volumes, const Fluid<Kernel>& fluid,
                    SolidBodies& solids, bool lists)
         : state_(state), volumes_(volumes), fluid_(fluid), solids_(solids), lists_(lists),
-          active_(state.has_fluid && solids.active() && solids.coupled()) {}
+          active_(state.has_fluid && solids.active() && solids.coupled()),
+          strong_(active_ && solids.has_rigid() && state.params.coupling.strong && state.params.coupling.predict_solids) {
+        if (active_ && lists_) {
+            // Room for every fluid particle of a lattice at r0 within h, and a quarter more.
+            const double reach = double(state.fluid.kernel.h) / double(state.params.fluid.spacing);
+            row_capacity_ = std::uint32_t(std::ceil(1.25 * 4.18879 * reach * reach * reach)) + 8;
+            const CouplingData c = solids.coupling();
+            const std::size_t slots = std::size_t(c.ibp_count) + c.sbp_count;
+            rows_.resize(slots * row_capacity_);
+            row_count_.resize(slots);
+        }
+        if (!strong_) return;
+        const std::size_t objects = solids.object_ibps().count;
+        for (DeviceArray<ObjectResponse>& r : response_) r.assign(objects, ObjectResponse{});
+        relaxation_.assign(objects, ResponseRelaxation{});
+        rigid_.upload(solids.rigid_objects());
+    }
 
     void bind(StepPlan& plan) override {
+        if (active_ && lists_) plan.bind("solid_volumes", [this](StepContext& step) { list_pairs(step); });
+        if (strong_)
+            plan.bind("solid_volumes", [this](StepContext& step) { step.pressure_response = this; });
         if (active_) plan.bind("coupling", [this](StepContext& step) { react(step); });
     }
 
-    void react(StepContext& step) {
-        const FluidConstants<Kernel>& fluid = state_.fluid;
-        CouplingData coupling = solids_.coupling();
+    // Iteration 0 (a new try): every object expected to keep its velocity; then each iteration
+    // the last one's reaction relaxes the expected accelerations, into the other buffer, so that
+    // the lookahead keeps the one the last iteration met (react() gathers against it).
+    void before_iteration(StepContext& step, Real dt, int iteration) override {
+        if (iteration == 0) {
+            current_ = 0;
+            start_object_responses(state_.device, response_[0].size(), response_[0].view().data(),
+                                   relaxation_.view().data());
+        } else {
+            const CouplingData coupling = gather(step, dt, rigid_.view().data());
+            ResponseStep response;
+            response.gravity = state_.fluid.gravity;
+            response.domain_min = solids_.domain_min();
+            response.domain_max = solids_.domain_max();
+            response.dt = dt;
+            relax_object_accelerations(state_.device, solids_.object_ibps(), state_.store.position.cview(),
+                                       state_.store.velocity.cview(), coupling.force, response,
+                                       response_[current_].view().data(), response_[1 - current_].view().data(),
+                                       relaxation_.view().data());
+            current_ = 1 - current_;
+        }
+        step.lookahead.object_response = response_[current_].view().data();
+    }
+
+    void react(StepContext& step) { gather(step, step.dt, nullptr); }
+
+    std::size_t bytes() const override {
+        return response_[0].bytes() + response_[1].bytes() + relaxation_.bytes() + rigid_.bytes() + rows_.bytes() +
+               row_count_.bytes();
+    }
+
+    // Each slot's fluid pairs for this step (lists only; coupling.hpp, list_slot_pairs).
+    void list_pairs(const StepContext& step) {
+        const CouplingData coupling = solids_.coupling();
+        list_slot_pairs(state_.device, pairs(step), std::size_t(coupling.ibp_count) + coupling.sbp_count,
+                        coupling.store_of_slot, state_.store.position.cview(), rows_.view().data(),
+                        row_count_.view().data());
+    }
+
+   private:
+    FluidPairs pairs(const StepContext& step) const {
         FluidPairs pairs;
         pairs.grid = step.neighbors.grid;
         pairs.fluid_end = step.ranges.fluid_end;
         pairs.solid_end = step.ranges.solid_end;
-        pairs.list_radius2 = lists_ ? fluid.kernel.h * fluid.kernel.h : Real(0);
+        pairs.list_radius2 = lists_ ? state_.fluid.kernel.h * state_.fluid.kernel.h : Real(0);
         pairs.lookahead = step.lookahead;
-        coupling.inverse_dt = Real(1) / step.dt;
-        fluid_reaction_on_solids(state_.device, pairs, coupling, state_.store.position.cview(),
+        if (lists_) {
+            pairs.rows = rows_.view().data();
+            pairs.row_count = row_count_.view().data();
+            pairs.row_capacity = row_capacity_;
+        }
+        return pairs;
+    }
+
+    // The reaction on every IBP and SBP (of the objects flagged in `objects`; null: all) from the
+    // fluid's last PCISPH iteration, and each IBP's force.
+    CouplingData gather(const StepContext& step, Real dt, const std::uint8_t* objects) {
+        const FluidConstants<Kernel>& fluid = state_.fluid;
+        CouplingData coupling = solids_.coupling();
+        if (objects) {
+            coupling.slot_object = solids_.slot_objects().data();
+            coupling.gather_object = objects;
+        }
+        coupling.inverse_dt = Real(1) / dt;
+        fluid_reaction_on_solids(state_.device, pairs(step), coupling, state_.store.position.cview(),
                                  state_.store.velocity.cview(), fluid_.predicted(), volumes_.volumes(),
                                  fluid_.pressure_term(), fluid, fluid_.has_viscosity() && fluid.wall_viscosity > Real(0));
         gather_solid_forces(state_.device, coupling);
+        return coupling;
     }
 
-   private:
     SimulationState<Kernel>& state_;
     const BoundaryVolumes<Kernel>& volumes_;
     const Fluid<Kernel>& fluid_;
     SolidBodies& solids_;
     bool lists_ = false;  // the fluid's pairs come from neighbour lists (their radius bounds the reaction's)
     bool active_ = false;
+    bool strong_ = false;  // coupling.strong: the solids answer inside PCISPH
+    DeviceArray<ObjectResponse> response_[2];  // per object, the expected acceleration: the one met and the next
+    int current_ = 0;
+    DeviceArray<ResponseRelaxation> relaxation_;  // per object, Aitken's last residual and ω
+    DeviceArray<std::uint8_t> rigid_;  // per object: 1 for a rigid one (the ones that answer)
+    std::uint32_t row_capacity_ = 0;     // lists: each slot's row of fluid pairs, this step's
+    DeviceArray<std::uint32_t> rows_, row_count_;
 };
 
 MW_BACKEND_END
