@@ -22,6 +22,9 @@
 //      rigid (with and without coupling.strong) and elastic, at 100, 500, 2,000 and 10,000 kg/m³,
 //      at CFL 0.4 and at CFL 1 under 30 ms: whether it runs to the end, steps, time, and how the
 //      cube ends.
+//   7c. The largest steps: the same throws at CFL 0.4, 0.7 and 1 (steps up to 30 ms) and at fixed
+//      steps of 1 to 30 ms, each judged as tests/core/test_extremes.cpp judges its cases: up to
+//      which setting a case holds, and how the next one fails.
 //   8. Heat conduction: scenes/warm_jelly.json (a warm elastic cube and a warm rigid block in cold
 //      water) without heat, and with it at its diffusivities and at 5 and 25 times them: steps,
 //      ms per step, the heat stage's median and its sub-steps.
@@ -48,6 +51,8 @@
 #include "apps/scene.hpp"
 #include "apps/scene_builder.hpp"
 #include "apps/speed_limit.hpp"
+#include "algorithms/pcisph_delta.hpp"
+#include "algorithms/sph_kernels.hpp"
 #include "simulation/factory.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/wall_gap.hpp"
@@ -64,7 +69,7 @@ struct Options {
     bool quick = false;
     std::string out;
     // The report's sections to run (--sections, comma-separated): all by default.
-    std::vector<std::string> sections{"dams", "splish", "variants", "kernels", "steps", "objects", "coupling", "extremes", "heat", "melting", "paper"};
+    std::vector<std::string> sections{"dams", "splish", "variants", "kernels", "steps", "objects", "coupling", "extremes", "largest_steps", "heat", "melting", "paper"};
     bool wants(const std::string& section) const {
         return std::find(sections.begin(), sections.end(), section) != sections.end();
     }
@@ -314,21 +319,21 @@ int main(int argc, char** argv) {
             std::stringstream list(argv[++i]);
             for (std::string name; std::getline(list, name, ',');) {
                 if (!Options{}.wants(name)) {  // the default holds every section
-                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels, steps, objects, coupling, extremes, heat, melting, paper)\n",
+                    std::fprintf(stderr, "bench_fluid: unknown section '%s' (dams, splish, variants, kernels, steps, objects, coupling, extremes, largest_steps, heat, melting, paper)\n",
                                  name.c_str());
                     return 2;
                 }
                 chosen.push_back(name);
             }
             if (chosen.empty()) {
-                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels, steps, objects, coupling, extremes, heat, melting, paper\n");
+                std::fprintf(stderr, "bench_fluid: --sections needs at least one of dams, splish, variants, kernels, steps, objects, coupling, extremes, largest_steps, heat, melting, paper\n");
                 return 2;
             }
             o.sections = chosen;
         } else {
             std::fprintf(stderr,
                          "usage: bench_fluid [--backend openmp|cuda] [--threads N] [--large] [--quick] "
-                         "[--sections dams,splish,variants,kernels,steps,objects,coupling,extremes,heat,melting,paper] [--out FILE]\n");
+                         "[--sections dams,splish,variants,kernels,steps,objects,coupling,extremes,largest_steps,heat,melting,paper] [--out FILE]\n");
             return 2;
         }
     }
@@ -640,6 +645,127 @@ int main(int argc, char** argv) {
                  "centre height at the end m |\n|---|---|---|---|---|---|---|---|---|---|\n"
               << rows;
             emit(t.str() + "\nOn the floor the cube's centre is at 0.06 m; floating, 0.25 m less its draft plus 0.06 m.\n\n");
+        }
+        // The largest steps (scenes/thrown_cube.json): each case of the extremes at rising CFL
+        // numbers, judged as tests/core/test_extremes.cpp judges its cases (ran to the end, nothing
+        // lost, no fluid within r0/2 of an IBP at the end, the fluid's and the IBPs' kinetic and
+        // potential energy never above their start by 0.1% (sampled every 10 steps), the fastest
+        // IBP under 0.5 m/s at the end, a cube heavier than water on the floor within r0/2).
+        if (o.wants("largest_steps")) {
+            const double end_time = o.quick ? 0.6 : 1.5;
+            // A run's settings: a CFL number (steps up to the scene's 30 ms) or a fixed step.
+            struct StepSetting {
+                const char* label;
+                std::vector<std::string> overrides;
+            };
+            const std::vector<StepSetting> cfl_settings = {{"0.4", {"solver.cfl_number=0.4"}},
+                                                           {"0.7", {"solver.cfl_number=0.7"}},
+                                                           {"1", {"solver.cfl_number=1"}}};
+            std::vector<StepSetting> fixed_settings;
+            for (const char* ms : {"1", "2", "4", "8", "16", "30"})
+                fixed_settings.push_back({ms, {"solver.dt_mode=\"fixed\"", std::string("solver.dt=") + std::to_string(std::atof(ms) / 1000)}});
+            std::string rows;
+            for (const char* kind : {"rigid", "elastic"})
+                for (const char* density : {"100", "500", "2000", "10000"}) {
+                    std::string cells;
+                    for (const std::vector<StepSetting>* settings : {&cfl_settings, static_cast<const std::vector<StepSetting>*>(&fixed_settings)}) {
+                    std::string holds = "none", fails = "-";
+                    for (const StepSetting& setting : *settings) {
+                        std::vector<std::string> overrides = {std::string("objects.0.kind=\"") + kind + "\"",
+                                                              std::string("objects.0.density=") + density};
+                        overrides.insert(overrides.end(), setting.overrides.begin(), setting.overrides.end());
+                        const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/thrown_cube.json", overrides);
+                        const SimulationSetup setup = build_setup(scene);
+                        const FluidParams& fp = setup.params.fluid;
+                        const double fluid_mass =
+                            fp.rest_density / prototype_sums(CubicSpline3D::with_support(fp.support_radius), fp.spacing, 3).sum_W;
+                        const SolidSetup& cube = setup.solids.front();
+                        const double ibp_mass = double(cube.density) * cube.spacing * cube.spacing * cube.spacing;
+                        const double g = -setup.params.gravity.y;
+                        HostParticles h;
+                        const auto energy = [&] {
+                            double e = 0;
+                            for (std::size_t i = 0; i < h.type.size(); ++i) {
+                                const double m = h.type[i] == kFluid ? fluid_mass : h.type[i] == kInnerBoundary ? ibp_mass : 0;
+                                e += m * (0.5 * double(norm2(h.velocity[i])) + g * double(h.position[i].y));
+                            }
+                            return e;
+                        };
+                        const double limit = speed_limit(scene, setup).limit;
+                        auto sim = make(o, setup);
+                        sim->download(h);
+                        const double e0 = energy();
+                        double gain = 0, top_dt = 0;
+                        std::string failed;
+                        try {
+                            for (long step = 1; sim->time() < end_time; ++step) {
+                                sim->step();
+                                const StepReport& rep = sim->last_report();
+                                top_dt = std::max(top_dt, rep.dt);
+                                if (!(rep.max_speed < limit) || !(rep.solid_max_speed < limit)) {
+                                    failed = "runaway";
+                                    break;
+                                }
+                                if (step % 10 == 0) {
+                                    sim->download(h);
+                                    gain = std::max(gain, (energy() - e0) / std::fabs(e0));
+                                }
+                            }
+                        } catch (const std::exception& e) {
+                            failed = "stopped";
+                        }
+                        if (failed.empty()) {
+                            sim->download(h);
+                            gain = std::max(gain, (energy() - e0) / std::fabs(e0));
+                            std::vector<Vec3> ibps;
+                            double centre = 0;
+                            for (std::size_t i = 0; i < h.type.size(); ++i)
+                                if (h.type[i] == kInnerBoundary) {
+                                    ibps.push_back(h.position[i]);
+                                    centre += h.position[i].y;
+                                }
+                            centre /= double(ibps.size());
+                            long inside = 0;
+                            const Real r0 = fp.spacing;
+                            for (std::size_t i = 0; i < h.type.size(); ++i)
+                                if (h.type[i] == kFluid)
+                                    for (const Vec3& b : ibps)
+                                        if (norm2(h.position[i] - b) < Real(0.25) * r0 * r0) {
+                                            ++inside;
+                                            break;
+                                        }
+                            const StepReport& last = sim->last_report();
+                            const double floor_centre = double(cube.density) > fp.rest_density ? 0.06 : centre;
+                            char why[160] = "";
+                            if (last.lost_particles > 0) std::snprintf(why, sizeof why, "%ld lost", last.lost_particles);
+                            else if (inside > 0) std::snprintf(why, sizeof why, "%ld fluid inside", inside);
+                            else if (gain > 1e-3) std::snprintf(why, sizeof why, "energy gained %.1f%%", 100 * gain);
+                            else if (!(last.solid_max_speed < 0.5)) std::snprintf(why, sizeof why, "still at %.2f m/s", last.solid_max_speed);
+                            else if (std::fabs(centre - floor_centre) > 0.5 * r0) std::snprintf(why, sizeof why, "%.3f m off the floor", centre - floor_centre);
+                            failed = why;
+                        }
+                        const bool cfl = settings == &cfl_settings;
+                        std::fprintf(stderr, "  largest steps %-8s %6s kg/m3 %s %-4s %s (largest step %.1f ms)\n", kind, density,
+                                     cfl ? "CFL" : "fixed ms", setting.label, failed.empty() ? "holds" : failed.c_str(), 1000 * top_dt);
+                        if (!failed.empty()) {
+                            fails = std::string(setting.label) + (cfl ? "" : " ms") + ": " + failed;
+                            break;
+                        }
+                        char held[64];
+                        if (cfl) std::snprintf(held, sizeof held, "%s (steps up to %.1f ms)", setting.label, 1000 * top_dt);
+                        else std::snprintf(held, sizeof held, "%s ms", setting.label);
+                        holds = held;
+                    }
+                    cells += " | " + holds + " | " + fails;
+                    }
+                    rows += std::string("| ") + kind + " | " + density + cells + " |\n";
+                }
+            emit("### The largest steps (scenes/thrown_cube.json, a 0.12 m cube thrown down at 5 m/s; to t = " +
+                 std::to_string(end_time).substr(0, 3) +
+                 " s)\n\n| kind | kg/m3 | holds up to CFL (steps capped at 30 ms) | the first CFL that fails | holds up to the fixed step | "
+                 "the first fixed step that fails |\n|---|---|---|---|---|---|\n" +
+                 rows + "\nA case holds when it runs to the end with nothing lost, no fluid inside the cube, no energy gained, the cube at rest and, "
+                        "heavier than water, on the floor; each column stops at the first setting that fails.\n\n");
         }
         // Heat conduction (scenes/warm_jelly.json): the stage's cost against the step's, as the
         // Fourier number, and with it the explicit sub-steps (algorithms/heat.hpp), grows.
