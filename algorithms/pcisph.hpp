@@ -103,22 +103,23 @@ inline void predict_positions(const DeviceContext& device, std::size_t fluid_cou
     });
 }
 
-// Where PCISPH meets the moving solids' boundary particles (store indices below `end`, above the
-// fluid) under coupling.predict_solids: where they will be at the end of the step, not where they
-// start it. LSM moves a solid after PCISPH, so a solid entering the fluid at the CFL step (0.4 r0
-// a step) would otherwise land inside fluid that was solved against where it had been: a box
-// thrown flat onto a resting pool at 2.5 m/s left a fluid particle 0.59 r0 under its surface
-// particles, and PCISPH diverged at every halving of the next step. A rigid object's particle is
-// taken Δt ahead at its own velocity (rotation included); a soft object's at its object's mean
-// velocity, since its own carries the object's vibration, which the fluid's pressure would answer
-// (the floating jelly's pool ran three times as fast; docs/coupling.md, "Solids met where they
-// will be"). Static boundary particles stay put.
 // A rigid object's expected acceleration in the step: linear, and angular about its centre
 // (coupling.hpp, relax_object_accelerations).
 struct ObjectResponse {
     Vec3 linear{0, 0, 0}, angular{0, 0, 0}, centre{0, 0, 0};
 };
 
+// Where PCISPH meets the moving solids' boundary particles (store indices below `end`, above the
+// fluid) under coupling.predict_solids: where they will be at the end of the step, not where they
+// start it. LSM moves a solid after PCISPH, so a solid entering the fluid at the CFL step (0.4 r0
+// a step) would otherwise land inside fluid that was solved against where it had been: a box
+// thrown flat onto a resting pool at 2.5 m/s left a fluid particle 0.59 r0 under its surface
+// particles, and PCISPH diverged at every halving of the next step. A rigid object's particle is
+// taken Δt ahead at its own velocity (rotation included), changed within the step by the
+// accelerations the solve expects (coupling.strong); a soft object's at its object's mean
+// velocity, since its own carries the object's vibration, which the fluid's pressure would answer
+// (the floating jelly's pool ran three times as fast; docs/coupling.md, "Solids met where they
+// will be"). Static boundary particles stay put.
 struct SolidLookahead {
     const Vec3* velocity = nullptr;            // the store's; null: every boundary particle where it is
     const Vec3* object_velocity = nullptr;        // per object, its mean velocity

@@ -276,10 +276,17 @@ void print_coupling(const InfoFacts& f) {
                     double(c.slip));
     else
         std::printf("            velocity-position correction against them off (coupling.correction false)\n");
-    if (c.predict_solids)
+    if (c.predict_solids) {
         std::printf("            PCISPH meets them where they will be at the end of the step (coupling.predict_solids): "
                     "rigid ones at their particles' velocity, soft ones at their mean velocity\n");
-    else
+        const bool rigid = std::any_of(scene.objects.begin(), scene.objects.end(),
+                                       [](const SceneObject& o) { return o.kind == SolidKind::kRigid; });
+        if (rigid && c.two_way && c.strong)
+            std::printf("            rigid ones answer the fluid's pressure inside every PCISPH iteration (coupling.strong)\n");
+        else if (rigid && c.two_way)
+            std::printf("            rigid ones feel the fluid's pressure only after PCISPH (coupling.strong false): it is "
+                        "solved as if they kept their velocity\n");
+    } else
         std::printf("            PCISPH meets them where they start the step (coupling.predict_solids false): one "
                     "entering the fluid fast can blow it up\n");
     const long with_tension = std::count_if(scene.objects.begin(), scene.objects.end(),

@@ -992,6 +992,19 @@ TEST_CASE("info: PCISPH meets moving objects where they will be, unless coupling
     CHECK(contains(wrong_type.err, "coupling.predict_solids"));
 }
 
+TEST_CASE("info: rigid objects answer the fluid's pressure inside PCISPH, unless coupling.strong is off") {
+    const std::string scene = tiny_scene_with_box("strong.json");  // a rigid box in the fluid
+    CHECK(info_json(scene)["scene"]["coupling"]["strong"] == true);
+    const Result on = run("info " + scene);
+    REQUIRE(on.code == 0);
+    CHECK(contains(on.out, "inside every PCISPH iteration (coupling.strong)"));
+    CHECK(contains(run("info " + scene + " --set coupling.strong=false").out,
+                   "only after PCISPH (coupling.strong false)"));
+    const Result wrong_type = run("info " + scene + " --set coupling.strong=1");
+    CHECK(wrong_type.code != 0);
+    CHECK(contains(wrong_type.err, "coupling.strong"));
+}
+
 TEST_CASE("info: interface tension is a stage among the non-pressure forces, when an object has it") {
     const std::string scene = tiny_scene_with_box("tension.json");
     const nlohmann::json on = info_json(scene, "--set objects.0.interface_tension=0.2");
