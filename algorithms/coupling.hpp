@@ -95,10 +95,10 @@ struct CouplingData {
     Real inverse_dt = 0;
     // Interface tension's η per SBP (interface_tension.hpp); null: none.
     const Real* sbp_eta = nullptr;
-    // Inside PCISPH (coupling.strong): only the slots of the objects flagged here (per object,
-    // by each slot's object) are gathered; null: every slot.
+    // Inside PCISPH (coupling.strong): only rigid objects' slots are gathered (each slot's object,
+    // and the objects' parameters); null: every slot.
     const std::int32_t* slot_object = nullptr;
-    const std::uint8_t* gather_object = nullptr;
+    const LsmObjectParams* rigid_only = nullptr;
 };
 
 // The pairs the fluid summed: in grid mode all in the 27 cells (the relation is symmetric:
@@ -153,7 +153,7 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
     const Real friction_scale = -c.mass * c.wall_viscosity / c.rest_density;  // -m μ_w / ρ0
     const bool lists = pairs.list_radius2 > Real(0);
     parallel_for(device, "coupling_reaction", std::size_t(d.ibp_count) + d.sbp_count, [=] MW_HD(std::size_t s) {
-        if (d.gather_object && !d.gather_object[d.slot_object[s]]) return;
+        if (d.rigid_only && !d.rigid_only[d.slot_object[s]].rigid) return;
         const std::uint32_t b = d.store_of_slot[s];
         // A solid particle that left the grid (counted as lost) meets no fluid.
         if (b < pairs.fluid_end || b >= pairs.solid_end) {
@@ -197,7 +197,7 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
 // Each IBP's force: its own reaction and its shares of the SBPs' (see the top of the file).
 inline void gather_solid_forces(const DeviceContext& device, const CouplingData d) {
     parallel_for(device, "coupling_to_ibps", d.ibp_count, [=] MW_HD(std::size_t s) {
-        if (d.gather_object && !d.gather_object[d.slot_object[s]]) return;
+        if (d.rigid_only && !d.rigid_only[d.slot_object[s]].rigid) return;
         Vec3 f = d.reaction[s];
         for (std::uint32_t e = d.share_offsets[s]; e < d.share_offsets[s + 1]; ++e)
             f += d.share_weight[e] * d.reaction[d.ibp_count + d.share_sbp[e]];
@@ -220,7 +220,7 @@ inline void gather_solid_forces(const DeviceContext& device, const CouplingData 
 // from its last two residuals r = G - a: a += ω r,
 // ω_k = -ω_{k-1} r_{k-1}·(r_k - r_{k-1}) / |r_k - r_{k-1}|², within [kMinRelaxation, 1], from
 // kFirstRelaxation (the angular part scaled by the object's half-diagonal). Only the rigid
-// objects' particles are gathered inside PCISPH (CouplingData::gather_object).
+// objects' particles are gathered inside PCISPH (CouplingData::rigid_only).
 // Elastic objects are met at their mean velocity, without an answer: measured, the same answer
 // (their mean acceleration) left the heavy elastic cubes at CFL 1 gaining energy or running away
 // at the floor in ways that changed with any detail of the relaxation (docs/coupling.md).

@@ -231,12 +231,6 @@ class SolidBodies final : public Module {
 
     bool active() const { return ibp_count_ > 0; }
     bool has_rigid() const { return has_rigid_; }
-    // Per object, 1 for a rigid one (host, for the strong coupling's gathers).
-    std::vector<std::uint8_t> rigid_objects() const {
-        std::vector<std::uint8_t> rigid;
-        for (const LsmObjectParams& o : objects_.to_host()) rigid.push_back(o.rigid ? 1 : 0);
-        return rigid;
-    }
     Vec3 domain_min() const { return domain_min_; }
     Vec3 domain_max() const { return domain_max_; }
     // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.

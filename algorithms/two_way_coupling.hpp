@@ -35,7 +35,6 @@ class TwoWayCoupling final : public Module, public PressureResponse {
         const std::size_t objects = solids.object_ibps().count;
         for (DeviceArray<ObjectResponse>& r : response_) r.assign(objects, ObjectResponse{});
         relaxation_.assign(objects, ResponseRelaxation{});
-        rigid_.upload(solids.rigid_objects());
     }
 
     void bind(StepPlan& plan) override {
@@ -54,7 +53,7 @@ class TwoWayCoupling final : public Module, public PressureResponse {
             start_object_responses(state_.device, response_[0].size(), response_[0].view().data(),
                                    relaxation_.view().data());
         } else {
-            const CouplingData coupling = gather(step, dt, rigid_.view().data());
+            const CouplingData coupling = gather(step, dt, true);
             ResponseStep response;
             response.gravity = state_.fluid.gravity;
             response.domain_min = solids_.domain_min();
@@ -69,10 +68,10 @@ class TwoWayCoupling final : public Module, public PressureResponse {
         step.lookahead.object_response = response_[current_].view().data();
     }
 
-    void react(StepContext& step) { gather(step, step.dt, nullptr); }
+    void react(StepContext& step) { gather(step, step.dt, false); }
 
     std::size_t bytes() const override {
-        return response_[0].bytes() + response_[1].bytes() + relaxation_.bytes() + rigid_.bytes() + rows_.bytes() +
+        return response_[0].bytes() + response_[1].bytes() + relaxation_.bytes() + rows_.bytes() +
                row_count_.bytes();
     }
 
@@ -100,14 +99,14 @@ class TwoWayCoupling final : public Module, public PressureResponse {
         return pairs;
     }
 
-    // The reaction on every IBP and SBP (of the objects flagged in `objects`; null: all) from the
+    // The reaction on every IBP and SBP (of the rigid objects only, with `rigid_only`) from the
     // fluid's last PCISPH iteration, and each IBP's force.
-    CouplingData gather(const StepContext& step, Real dt, const std::uint8_t* objects) {
+    CouplingData gather(const StepContext& step, Real dt, bool rigid_only) {
         const FluidConstants<Kernel>& fluid = state_.fluid;
         CouplingData coupling = solids_.coupling();
-        if (objects) {
+        if (rigid_only) {
             coupling.slot_object = solids_.slot_objects().data();
-            coupling.gather_object = objects;
+            coupling.rigid_only = solids_.object_ibps().params;
         }
         coupling.inverse_dt = Real(1) / dt;
         fluid_reaction_on_solids(state_.device, pairs(step), coupling, state_.store.position.cview(),
@@ -127,7 +126,6 @@ class TwoWayCoupling final : public Module, public PressureResponse {
     DeviceArray<ObjectResponse> response_[2];  // per object, the expected acceleration: the one met and the next
     int current_ = 0;
     DeviceArray<ResponseRelaxation> relaxation_;  // per object, Aitken's last residual and ω
-    DeviceArray<std::uint8_t> rigid_;  // per object: 1 for a rigid one (the ones that answer)
     std::uint32_t row_capacity_ = 0;     // lists: each slot's row of fluid pairs, this step's
     DeviceArray<std::uint32_t> rows_, row_count_;
 };
