@@ -30,6 +30,7 @@
 #include "algorithms/lsm_regions.hpp"
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/pcisph.hpp"
+#include "algorithms/solid_face.hpp"
 
 namespace mw {
 
@@ -93,8 +94,10 @@ struct CouplingData {
     // null without it, solid_contact.hpp): they join this step's reaction as J / Δt.
     const Vec3* sbp_contact_impulse = nullptr;
     Real inverse_dt = 0;
-    // Interface tension's η per SBP (interface_tension.hpp); null: none.
+    // Interface tension's η per SBP (interface_tension.hpp); null: none. It pulls toward the
+    // SBPs' face points.
     const Real* sbp_eta = nullptr;
+    SbpFaces faces;
     // Inside PCISPH (coupling.strong): only rigid objects' slots are gathered (each slot's object,
     // and the objects' parameters); null: every slot.
     const std::int32_t* slot_object = nullptr;
@@ -164,13 +167,15 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
         const Real eta = d.sbp_eta && s >= d.ibp_count ? d.sbp_eta[s - d.ibp_count] : Real(0);
         Vec3 pressure_sum{0, 0, 0}, friction_sum{0, 0, 0}, tension_sum{0, 0, 0};
         const Vec3 xb_met = pairs.lookahead.place(b, xb);
+        const Vec3 xb_face = eta > Real(0) ? d.faces.at(xb, static_cast<std::uint32_t>(s - d.ibp_count)) : xb;
+        const Real h2 = c.kernel.h * c.kernel.h;
         const auto add = [&](std::uint32_t i, Real paired) {
             const Vec3 xi = position[i];
             const Vec3 r = predicted[i] - xb_met;
             pressure_sum += (paired * pressure_term[i]) * c.kernel.grad_W_r2(r, norm2(r));
             if (friction) friction_sum += c.kernel.laplacian_visc_r2(norm2(xi - xb)) * (vb - velocity[i]);
-            if (eta > Real(0)) {
-                const Vec3 x_is = xi - xb;
+            if (eta > Real(0) && norm2(xi - xb) < h2) {
+                const Vec3 x_is = xi - xb_face;
                 const Real r2 = norm2(x_is);
                 const Real w = c.kernel.W_r2(r2);
                 if (w > Real(0) && r2 > Real(0)) tension_sum += (w / std::sqrt(r2)) * x_is;

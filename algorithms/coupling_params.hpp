@@ -17,6 +17,9 @@ struct CouplingParams {
     // Rigid objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids):
     // each iteration meets them where gravity and the last iterations' pressure take them.
     bool strong = true;
+    // Rigid objects' surface particles sit inside their mesh's face by the walls' gap
+    // (sampling/surface_inset.hpp), so that the fluid rests at the face as it does at a wall.
+    bool surface_inset = true;
 };
 
 inline const ParamTable<CouplingParams>& coupling_keys() {
@@ -33,6 +36,8 @@ inline const ParamTable<CouplingParams>& coupling_keys() {
                                    "PCISPH meets the objects where the step will take them, not where they start it"));
         t.push_back(boolean_key<T>("coupling", "strong", member(&T::strong),
                                    "rigid objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids)"));
+        t.push_back(boolean_key<T>("coupling", "surface_inset", member(&T::surface_inset),
+                                   "rigid objects' surface particles sit inside the face by the walls' gap, so fluid rests at the face"));
         return t;
     }();
     return table;

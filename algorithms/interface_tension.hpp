@@ -4,7 +4,8 @@
 //
 //   F_{i<-s} = -η_s m_i ψ_s W(x_is, h) x_is / |x_is|,   ψ_s = ρ0 V_s,  x_is = x_i - x_s,
 //
-// a non-pressure force, from the positions at the start of the step (like viscosity). Its
+// a non-pressure force, from the positions at the start of the step (like viscosity), with x_s
+// the SBP's face point (solid_face.hpp) over the pairs within h of the SBP itself. Its
 // reaction F_{s<-i} = -F_{i<-s} goes back to the object with the other coupling forces
 // (coupling.hpp), over the same pairs: every pair within h, which the 27 cells around either
 // particle hold, so the pair's two forces cancel to rounding.
@@ -22,6 +23,7 @@
 #include "algorithms/module.hpp"
 #include "algorithms/particle_types.hpp"
 #include "algorithms/solid_bodies.hpp"
+#include "algorithms/solid_face.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -30,6 +32,7 @@ struct TensionData {
     View<const std::uint8_t> type;  // store fields
     View<const std::int32_t> solid_slot;
     const Real* sbp_eta = nullptr;  // η per SBP index; null: no tension anywhere
+    SbpFaces faces;                 // where each SBP meets the fluid (solid_face.hpp)
     std::uint32_t ibp_count = 0;    // SBP k has solid slot ibp_count + k
 };
 
@@ -45,11 +48,14 @@ void add_interface_tension(const DeviceContext& device, GridView grid, std::size
         grid.for_each_solid(xi, [&](std::uint32_t b) {
             // A melting object's SBPs (IBP slots, melting.hpp) take no tension yet.
             if (t.type[b] != kSurfaceBoundary || std::uint32_t(t.solid_slot[b]) < t.ibp_count) return;
-            const Vec3 r = xi - position[b];
+            // The pair: within h of the SBP (as the coupling's reaction pairs them); the pull:
+            // toward its face point.
+            if (!(norm2(xi - position[b]) < kernel.h * kernel.h)) return;
+            const std::uint32_t s = static_cast<std::uint32_t>(t.solid_slot[b]) - t.ibp_count;
+            const Vec3 r = xi - t.faces.at(position[b], s);
             const Real r2 = norm2(r);
             const Real w = kernel.W_r2(r2);
             if (!(w > Real(0)) || !(r2 > Real(0))) return;
-            const std::uint32_t s = static_cast<std::uint32_t>(t.solid_slot[b]) - t.ibp_count;
             sum += (t.sbp_eta[s] * boundary_volume[b] * w / std::sqrt(r2)) * r;
         });
         const Vec3 a = -rest_density * sum;
@@ -82,6 +88,7 @@ class InterfaceTension final : public Module {
         t.type = state_.store.type.cview();
         t.solid_slot = solids_.solid_slot_view();
         t.sbp_eta = solids_.sbp_eta();
+        t.faces = solids_.sbp_faces();
         t.ibp_count = static_cast<std::uint32_t>(solids_.ibp_count());
         add_interface_tension(state_.device, step.neighbors.grid, step.ranges.fluid_end, state_.store.position.cview(),
                               volumes_.volumes(), fluid_.nonpressure(), t, state_.fluid.kernel,

@@ -57,6 +57,7 @@ struct SbpLink {
     std::uint32_t corner[3];  // GP indices (0 .. gp_count) of the triangle's corners
     Vec3 bary;
     Real sign;  // +1 or -1: orients the deformed triangle's normal like the sampled one
+    Real inset;  // m: the SBP sits this far inside the triangle, along its normal
 };
 
 struct LsmHostLayout {
@@ -90,6 +91,7 @@ struct LsmHostLayout {
     // SBPs
     std::vector<SbpLink> sbp;
     std::vector<Vec3> sbp_normal;
+    std::vector<Real> sbp_inset;
     std::vector<LsmObjectParams> objects;
 
     std::size_t region_count() const { return region_mass.size(); }
@@ -304,7 +306,7 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
             L.gp_offsets.push_back(std::uint32_t(L.gp_links.size()));
         }
         if (s.sbp_corners.size() != s.sbp.size() || s.sbp_barycentric.size() != s.sbp.size() ||
-            s.sbp_normal.size() != s.sbp.size())
+            s.sbp_normal.size() != s.sbp.size() || (!s.sbp_inset.empty() && s.sbp_inset.size() != s.sbp.size()))
             throw InputError("solid '" + s.name + "': SBP lists differ in length");
         for (std::size_t k = 0; k < s.sbp.size(); ++k) {
             check_index(s.sbp[k], "sbp", s.name);
@@ -320,8 +322,12 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
             link.bary = s.sbp_barycentric[k];
             const Vec3 n = cross(corner[1] - corner[0], corner[2] - corner[0]);
             link.sign = dot(n, s.sbp_normal[k]) < 0 ? Real(-1) : Real(1);
+            link.inset = s.sbp_inset.empty() ? Real(0) : s.sbp_inset[k];
+            if (!(link.inset >= Real(0)) || !(link.inset < s.spacing))
+                throw InputError("solid '" + s.name + "': an SBP's inset is outside [0, r0)");
             L.sbp.push_back(link);
             L.sbp_normal.push_back(s.sbp_normal[k]);
+            L.sbp_inset.push_back(link.inset);
         }
     }
 }

@@ -120,6 +120,7 @@ class SolidBodies final : public Module {
         gp_weights_.upload(L.gp_weights);
         sbp_.upload(L.sbp);
         sbp_normal_.upload(L.sbp_normal);
+        upload_surface_insets(L, setup);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
         // Each SBP's object, as an index into setup.solids (the layout's order: moving objects in
@@ -403,6 +404,7 @@ class SolidBodies final : public Module {
         c.share_weight = share_weight_.view().data();
         if (!sbp_impulse_.empty()) c.sbp_contact_impulse = sbp_impulse_.view().data();
         if (!sbp_eta_.empty()) c.sbp_eta = sbp_eta_.view().data();
+        c.faces = sbp_faces();
         return c;
     }
 
@@ -414,10 +416,12 @@ class SolidBodies final : public Module {
         c.type = store.type.cview();
         c.solid_slot = solid_slot_->cview();
         c.sbp_normal = sbp_normal_.view().data();
+        c.sbp_inset = sbp_faces().inset;
         c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
         c.sbp_count = static_cast<std::uint32_t>(sbp_count_);
         c.band = band;
         c.reach = reach;
+        c.sbp_reach = Real(1.001) * (reach + largest_inset_);  // a margin over rounding: the SBPs' gather has no such test
         return c;
     }
     // The correction after the integration (solid_contact.hpp); the slot map must be current.
@@ -459,6 +463,11 @@ class SolidBodies final : public Module {
         return sum_by_object(sbp_impulse_.to_host(), sbp_object_);
     }
     View<const Vec3> sbp_normals() const { return sbp_normal_.cview(); }
+    // Where the SBPs meet the fluid (solid_face.hpp), and whether any sits inside its face.
+    SbpFaces sbp_faces() const {
+        return SbpFaces{sbp_normal_.view().data(), sbp_inset_.empty() ? nullptr : sbp_inset_.view().data()};
+    }
+    bool surface_inset() const { return !sbp_inset_.empty(); }
 
     // Checkpoints (state_archive.hpp): what the solids carry from one step to the next. The
     // layout (rest shape, regions, links) is rebuilt from the scene; this is the rest: the
@@ -487,7 +496,7 @@ class SolidBodies final : public Module {
                rotation_.bytes() + rotation_matrix_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
                region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
-               sbp_.bytes() + sbp_normal_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
+               sbp_.bytes() + sbp_normal_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
                object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes() +
                body_motion_.bytes();
@@ -552,10 +561,40 @@ class SolidBodies final : public Module {
         g.gp_weights = gp_weights_.view().data();
         g.sbp = sbp_.view().data();
         g.sbp_normal = sbp_normal_.view().data();
+        if (!sbp_inset_.empty()) {
+            g.sbp_inset = sbp_inset_.view().data();
+            g.wall_lo = domain_min_;
+            g.wall_hi = domain_max_;
+            g.inset_fade = inset_fade_;
+        }
         return g;
     }
 
    private:
+    // The SBPs' insets (solid_face.hpp), kept only where one is set in (null faces otherwise: no
+    // read in the gathers): each one's where the scene starts, faded near the walls as the scene
+    // builder placed it and each step will.
+    void upload_surface_insets(const LsmHostLayout& L, const SimulationSetup& setup) {
+        const bool any = std::any_of(L.sbp_inset.begin(), L.sbp_inset.end(), [](Real inset) { return inset > Real(0); });
+        if (!any) {
+            sbp_inset_.resize(0);
+            largest_inset_ = 0;
+            return;
+        }
+        const BoundaryParams& b = setup.params.boundary;
+        inset_fade_ = surface_inset_fade(b.walls, setup.params.fluid.support_radius, b.wall_gap);
+        std::vector<Real> start(L.sbp_count);
+        for (std::size_t k = 0; k < L.sbp_count; ++k) {
+            const SbpLink& link = L.sbp[k];
+            const Vec3 face = link.bary.x * L.gp_rest[link.corner[0]] + link.bary.y * L.gp_rest[link.corner[1]] +
+                              link.bary.z * L.gp_rest[link.corner[2]];
+            start[k] = faded_inset(link.inset, face, L.sbp_normal[k], setup.params.domain_min, setup.params.domain_max,
+                                   inset_fade_);
+        }
+        sbp_inset_.upload(start);
+        largest_inset_ = *std::max_element(L.sbp_inset.begin(), L.sbp_inset.end());
+    }
+
     // Visits each state array of `self` (a SolidBodies, const or not) with its block name.
     template <class Self, class Visit>
     static void for_each_state_array(Self& self, Visit&& visit) {
@@ -571,6 +610,7 @@ class SolidBodies final : public Module {
         visit("solids.force", self.force_);
         visit("solids.reaction", self.reaction_);
         visit("solids.sbp_normal", self.sbp_normal_);
+        visit("solids.sbp_inset", self.sbp_inset_);
         visit("solids.sbp_impulse", self.sbp_impulse_);
     }
 
@@ -624,6 +664,9 @@ class SolidBodies final : public Module {
     DeviceArray<Real> gp_weights_;
     DeviceArray<SbpLink> sbp_;
     DeviceArray<Vec3> sbp_normal_;
+    DeviceArray<Real> sbp_inset_;  // m, by SBP index, this step's (faded); empty: every SBP on its face
+    Real inset_fade_ = 0;          // m (interpolate_surface)
+    Real largest_inset_ = 0;       // m
     // Two-way coupling (coupling.hpp): this step's reaction per IBP and SBP slot, and the SBPs'
     // shares of each IBP.
     DeviceArray<Vec3> reaction_;

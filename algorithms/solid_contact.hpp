@@ -15,8 +15,8 @@
 //   the solid: gets the impulse J = -m_i Δv_i, shared among the SBPs k was built from by
 //           w_s / Σ w (the paper's Eq. 18 projects the change on each SBP's velocity, which is
 //           undefined for an SBP at rest; docs/method.md). Each SBP gathers its shares from the fluid
-//           particles within r0 of it, with the same weights on the same numbers, so the shares
-//           add up to J.
+//           particles within r0 of its face point (solid_face.hpp), with the same weights on the
+//           same numbers, so the shares add up to J.
 //
 // The SBPs' contact mass: what LSM moves when a force lands on the SBP (docs/coupling.md). Its
 // force goes to IBPs d by the shares w_sd (coupling.hpp); a force F on IBP d, split among its n_d
@@ -119,7 +119,7 @@ inline void gather_sbp_impulses(const DeviceContext& device, std::size_t fluid_e
         const std::uint32_t b = d.store_of_slot[surface.ibp_count + k];
         Vec3 sum{0, 0, 0};
         if (b >= fluid_end && b < solid_end) {  // an SBP that left the grid meets no fluid
-            const Vec3 xs = position[b];
+            const Vec3 xs = surface.faces().at(position[b], static_cast<std::uint32_t>(k));
             surface.grid.for_each_fluid_around_particle(b, [&](std::uint32_t i) {
                 const Real w = contact_weight(position[i], xs, surface.reach);
                 if (w > Real(0)) sum += w * d.impulse_per_weight[i];

@@ -6,10 +6,12 @@
 // position after this step's update: with α < 1 or external forces the goal is a step behind
 // the particles, and the surface the fluid sees must sit on the particles that carry the forces.
 // GP velocity is its displacement over the step; SBP velocity interpolates the GP velocities.
+// An SBP sits its inset inside its triangle along the deformed normal (sampling/surface_inset.hpp).
 #pragma once
 #include <cmath>
 
 #include "algorithms/lsm_regions.hpp"
+#include "algorithms/solid_face.hpp"
 #include "backend/backend.hpp"
 
 MW_BACKEND_BEGIN
@@ -28,6 +30,11 @@ struct InterpolationData {
     const Real* gp_weights = nullptr;         // normalised
     const SbpLink* sbp = nullptr;
     Vec3* sbp_normal = nullptr;
+    // Each SBP's inset this step (null: none set in), faded near the domain walls [wall_lo,
+    // wall_hi] over `inset_fade` (solid_face.hpp, faded_inset).
+    Real* sbp_inset = nullptr;
+    Vec3 wall_lo{0, 0, 0}, wall_hi{0, 0, 0};
+    Real inset_fade = 0;
 };
 
 inline void interpolate_geometry(const DeviceContext& device, const InterpolationData d, Real dt) {
@@ -58,9 +65,18 @@ inline void interpolate_surface(const DeviceContext& device, const Interpolation
         }
         const Vec3 n = link.sign * cross(c[1] - c[0], c[2] - c[0]);
         const Real len = norm(n);
-        if (len > Real(0)) d.sbp_normal[k] = n / len;  // a collapsed triangle keeps its last normal
+        Vec3 normal = d.sbp_normal[k];  // a collapsed triangle keeps its last normal
+        if (len > Real(0)) {
+            normal = n / len;
+            d.sbp_normal[k] = normal;
+        }
         const std::uint32_t i = d.store_of_slot[d.sbp_first + k];
-        d.position[i] = x;
+        Real inset = link.inset;
+        if (d.sbp_inset) {
+            inset = faded_inset(inset, x, normal, d.wall_lo, d.wall_hi, d.inset_fade);
+            d.sbp_inset[k] = inset;
+        }
+        d.position[i] = x - inset * normal;
         d.velocity[i] = v;
     });
 }

@@ -3,6 +3,8 @@
 // to an elastic or rigid object's surface particles (SBPs). Read by the correction after the
 // integration (solid_contact.hpp) and by its position rule inside the PCISPH loop (pcisph.hpp).
 //
+//   x_s   = SBP s's face point (solid_face.hpp): where the mesh's face is, the SBP itself sitting
+//           its inset inside it (sampling/surface_inset.hpp)
 //   S     = the SBPs s with |x_i - x_s| < r0
 //   w_s   = (1 - |x_i - x_s| / r0)³ (the paper's W(x, r0), from [YLHQ12])
 //   x_k, v_k, n_k = the w-weighted means over S (n_k normalised); 1/m_k the w-weighted mean of
@@ -27,17 +29,20 @@
 // beside the disc (past an edge of the object, where S holds only the SBPs nearest the edge) is
 // as far from the surface as from the disc's rim, not as far as from the plane.
 //
-// The correction acts only within the band c = kMovingSolidContact r0 of that surface: fluid at
-// rest lies 0.65-0.8 r0 from an object's SBPs (0.81 r0 under a floating box, docs/coupling.md),
-// which a band of r0 would hold on its edge, as it would at the walls with a band of r0
-// (wall_contact.hpp). The test radius stays r0, so that fluid up to r0 inside the
-// surface is still found and put back.
+// The correction acts only within the band c of that surface (wall_contact.hpp): with the SBPs
+// set in (a rigid object's), kInsetSolidContact r0 (fluid at rest lies a median 0.34-0.40 r0 off
+// the face); in a scene with none set in, kMovingSolidContact r0 (fluid at rest lies 0.65-0.8 r0
+// from SBPs on the face, which a band of r0 would hold on its edge, as it would at the walls with
+// a band of r0). The band is the scene's (SolidCorrection): beside a rigid object set in, an
+// elastic object's SBPs are met with the narrower band too. The test radius stays r0, so that fluid up to r0 inside the surface is
+// still found and put back.
 #pragma once
 #include <cmath>
 #include <cstdint>
 
 #include "algorithms/neighbor_grid.hpp"
 #include "algorithms/particle_types.hpp"
+#include "algorithms/solid_face.hpp"
 
 namespace mw {
 
@@ -83,15 +88,20 @@ struct SolidSurface {
     View<const std::uint8_t> type;  // store fields
     View<const std::int32_t> solid_slot;
     const Vec3* sbp_normal = nullptr;  // by SBP index; null: no correction against solids
+    const Real* sbp_inset = nullptr;   // by SBP index (solid_face.hpp); null: on the face
     std::uint32_t ibp_count = 0, sbp_count = 0;  // SBP k has solid slot ibp_count + k
     Real band = 0;   // c, m
     Real reach = 0;  // r0, m
+    // reach plus the largest inset: an SBP farther than this from a fluid particle has its face
+    // point out of reach too, and is passed over without reading its normal and inset.
+    Real sbp_reach = 0;
     // Per fluid particle, this step: whether a moving solid's particle lies in the cells its
     // gather visits (mark_fluid_near_solids); null: gather for every particle. Far from the
     // solids, as most fluid is, the rule then costs one byte read per prediction, not a gather.
     const std::uint8_t* fluid_near_solid = nullptr;
 
     MW_INLINE bool active() const { return sbp_normal != nullptr; }
+    MW_INLINE SbpFaces faces() const { return SbpFaces{sbp_normal, sbp_inset}; }
 
     // The virtual particle fluid particle i at x faces: a gather over the SBPs around the cell i
     // was sorted into at this step's build (neighbor_grid.hpp), from the store's positions and
@@ -105,10 +115,12 @@ struct SolidSurface {
             // A melting object's SBPs are lattice vertices (IBP slots) with no surface normal:
             // not in the correction yet (docs/melting.md).
             if (type[j] != kSurfaceBoundary || std::uint32_t(solid_slot[j]) < ibp_count) return;
-            const Vec3 xs = position[j];
+            const Vec3 sbp = position[j];
+            if (!(norm2(x - sbp) < sbp_reach * sbp_reach)) return;
+            const std::uint32_t s = static_cast<std::uint32_t>(solid_slot[j]) - ibp_count;
+            const Vec3 xs = faces().at(sbp, s);
             const Real w = contact_weight(x, xs, reach);
             if (!(w > Real(0))) return;
-            const std::uint32_t s = static_cast<std::uint32_t>(solid_slot[j]) - ibp_count;
             k.weight += w;
             k.position += w * xs;
             k.velocity += w * velocity[j];

@@ -88,6 +88,10 @@ constexpr double kStaticObjectContact = 0.45;
 // The band of moving (elastic and rigid) objects, in r0, for their own correction
 // (solid_contact.hpp): as static mesh objects', which are sampled the same way.
 constexpr double kMovingSolidContact = kStaticObjectContact;
+// The band of moving objects whose SBPs sit inside their face (sampling/surface_inset.hpp),
+// measured from the face: fluid rests a median 0.34-0.40 r0 off it, where a band of 0.45 r0
+// moves resting fluid every step (docs/coupling.md).
+constexpr double kInsetSolidContact = 0.3;
 
 struct WallContact {
     static constexpr Real kFar = std::numeric_limits<Real>::max();

@@ -10,6 +10,7 @@
 #include "apps/speed_limit.hpp"
 #include "simulation/factory.hpp"
 #include "common/errors.hpp"
+#include "sampling/wall_gap.hpp"
 
 namespace mw {
 
@@ -269,18 +270,31 @@ void print_coupling(const InfoFacts& f) {
         std::printf("coupling    one-way (coupling.two_way false): %ld moving object(s) push the fluid and feel none "
                     "of it\n",
                     f.moving_objects);
+    const bool rigid = std::any_of(scene.objects.begin(), scene.objects.end(),
+                                   [](const SceneObject& o) { return o.kind == SolidKind::kRigid; });
+    // Rigid objects' surface particles set in (sampling/surface_inset.hpp); the correction's band
+    // follows (algorithms/solid_correction.hpp).
+    const bool set_in = rigid && c.surface_inset;
+    if (set_in) {
+        const FluidParams& fp = scene.params.fluid;
+        const double inset = rest_density_wall_gap(fp.spacing, fp.support_radius, fp.spacing / 2, 1, fp.kernel);
+        std::printf("            rigid ones' surface particles sit %.2f r0 inside their faces, where the fluid rests as "
+                    "at a wall (coupling.surface_inset)\n",
+                    inset / double(fp.spacing));
+    }
+    else if (rigid)
+        std::printf("            rigid ones' surface particles sit on their faces (coupling.surface_inset false): "
+                    "the fluid rests about one r0 off them\n");
     if (c.correction)
         std::printf("            velocity-position correction against them on (coupling.correction): fluid moving into "
                     "one stops %.2f r0 from its surface%s, slip %g\n",
-                    kMovingSolidContact, c.two_way ? " and trades momentum with it" : " and takes its velocity",
-                    double(c.slip));
+                    set_in ? kInsetSolidContact : kMovingSolidContact,
+                    c.two_way ? " and trades momentum with it" : " and takes its velocity", double(c.slip));
     else
         std::printf("            velocity-position correction against them off (coupling.correction false)\n");
     if (c.predict_solids) {
         std::printf("            PCISPH meets them where they will be at the end of the step (coupling.predict_solids): "
                     "rigid ones at their particles' velocity, soft ones at their mean velocity\n");
-        const bool rigid = std::any_of(scene.objects.begin(), scene.objects.end(),
-                                       [](const SceneObject& o) { return o.kind == SolidKind::kRigid; });
         if (rigid && c.two_way && c.strong)
             std::printf("            rigid ones answer the fluid's pressure inside every PCISPH iteration (coupling.strong)\n");
         else if (rigid && c.two_way)

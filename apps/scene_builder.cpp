@@ -6,6 +6,7 @@
 #include <string>
 
 #include "algorithms/lsm_regions.hpp"
+#include "algorithms/solid_face.hpp"
 #include "common/errors.hpp"
 #include "sampling/box_particles.hpp"
 #include "sampling/disc_lattice.hpp"
@@ -15,6 +16,7 @@
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/signed_distance.hpp"
 #include "sampling/solid_sample.hpp"
+#include "sampling/surface_inset.hpp"
 #include "sampling/wall_gap.hpp"
 
 #include <filesystem>
@@ -444,8 +446,24 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
     solid.gp_offsets = sample.gp.offsets;
     solid.gp_links = sample.gp.ibp;
     for (double w : sample.gp.weight) solid.gp_weights.push_back(Real(w));
+    // A rigid object's SBPs set in (coupling.surface_inset): as far inside the face as a wall's
+    // single layer of spacing r0/2 sits outside it, half the thickness where the object is
+    // thinner; an open mesh has no inside to set them into. An elastic object's stay on the face:
+    // set in, a light elastic cube thrown into water blew up (docs/coupling.md).
+    std::vector<double> inset(sample.sbp.count(), 0.0);
+    if (setup.params.coupling.surface_inset && solid.kind == SolidKind::kRigid && sample.stats.closed) {
+        const double depth = rest_density_wall_gap(Real(r0), Real(h), Real(r0 / 2), 1, setup.params.fluid.kernel);
+        inset = surface_insets(sample.geometry, sample.sbp, depth);
+    }
+    // Where each step puts them (solid_face.hpp: faded near the domain walls).
+    const BoundaryParams& walls = setup.params.boundary;
+    const Real fade = surface_inset_fade(walls.walls, setup.params.fluid.support_radius, walls.wall_gap);
     for (std::size_t k = 0; k < sample.sbp.count(); ++k) {
-        solid.sbp.push_back(push(to_vec3(sample.sbp.positions[k]), kSurfaceBoundary));
+        const Real faded = faded_inset(Real(inset[k]), to_vec3(sample.sbp.positions[k]), to_vec3(sample.sbp.normals[k]),
+                                       setup.params.domain_min, setup.params.domain_max, fade);
+        const Vec3d set_in = sample.sbp.positions[k] - double(faded) * sample.sbp.normals[k];
+        solid.sbp.push_back(push(to_vec3(set_in), kSurfaceBoundary));
+        solid.sbp_inset.push_back(Real(inset[k]));
         // Barycentric weights refer to the corners of the sampler's (oriented) triangle.
         solid.sbp_corners.push_back(solid.triangles[std::size_t(sample.sbp.triangles[k])]);
         solid.sbp_barycentric.push_back(to_vec3(sample.sbp.barycentric[k]));

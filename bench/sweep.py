@@ -304,7 +304,7 @@ def floating_measure(meltwater, sim, r0, settle, ratio=0.5):
 def held_box_scene(r0):
     scene = floating_scene(r0, 0.5)
     box = scene["objects"][0]
-    box["kind"] = "elastic"  # every IBP pinned: the lattice, and the mesh and SBPs on it, never move
+    box["kind"] = "rigid"  # every IBP pinned: the lattice, and the mesh and SBPs on it, never move
     box["pinned"] = {"box": {"min": [0, 0, 0], "max": [POOL, POOL, POOL]}}
     return scene
 

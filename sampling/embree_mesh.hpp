@@ -15,6 +15,28 @@
 
 namespace mw {
 
+// A ray from `origin` along `direction` (both in Embree's coordinates) over [tnear, tfar], with
+// no hit recorded yet.
+inline RTCRayHit embree_ray(const Vec3d& origin, const Vec3d& direction, float tnear, float tfar) {
+    RTCRayHit rh;
+    rh.ray.org_x = float(origin.x());
+    rh.ray.org_y = float(origin.y());
+    rh.ray.org_z = float(origin.z());
+    rh.ray.dir_x = float(direction.x());
+    rh.ray.dir_y = float(direction.y());
+    rh.ray.dir_z = float(direction.z());
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.time = 0.f;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+}
+
 class EmbreeMesh {
 public:
     // `intersect_filter`, when given, is attached to the triangles (called for every ray hit).

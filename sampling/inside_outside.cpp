@@ -87,22 +87,7 @@ public:
               << " from the centre of a mesh of size " << reach << ", beyond what the single-precision ray tracer handles";
             throw InputError(s.str());
         }
-        RTCRayHit rh;
-        rh.ray.org_x = float(org.x());
-        rh.ray.org_y = float(org.y());
-        rh.ray.org_z = float(org.z());
-        rh.ray.dir_x = float(dir.x());
-        rh.ray.dir_y = float(dir.y());
-        rh.ray.dir_z = float(dir.z());
-        rh.ray.tnear = 0.f;
-        rh.ray.tfar = std::numeric_limits<float>::infinity();
-        rh.ray.time = 0.f;
-        rh.ray.mask = 0xFFFFFFFFu;
-        rh.ray.id = 0;
-        rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        RTCRayHit rh = embree_ray(org, dir, 0.f, std::numeric_limits<float>::infinity());
         HitCollector collector;
         rtcInitIntersectContext(&collector.context);
         collector.hits = &hits;

@@ -64,6 +64,9 @@ struct SolidSetup : SolidParams {
     std::vector<std::array<int, 3>> sbp_corners;
     std::vector<Vec3> sbp_barycentric;
     std::vector<Vec3> sbp_normal;
+    // How far each SBP sits inside the face along its normal (m; empty: on it), where the fluid
+    // meets the face point x_s + inset n_s (sampling/surface_inset.hpp).
+    std::vector<Real> sbp_inset;
     // The mesh (over GP indices, outward) for output; static objects keep their vertices here.
     std::vector<std::array<int, 3>> triangles;
     std::vector<Vec3> rest_vertices;

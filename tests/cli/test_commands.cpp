@@ -1005,6 +1005,21 @@ TEST_CASE("info: rigid objects answer the fluid's pressure inside PCISPH, unless
     CHECK(contains(wrong_type.err, "coupling.strong"));
 }
 
+TEST_CASE("info: rigid objects' surface particles sit inside their faces, unless coupling.surface_inset is off") {
+    const std::string scene = tiny_scene_with_box("inset.json");  // a rigid box in the fluid
+    CHECK(info_json(scene)["scene"]["coupling"]["surface_inset"] == true);
+    const Result on = run("info " + scene);
+    REQUIRE(on.code == 0);
+    CHECK(contains(on.out, "inside their faces, where the fluid rests as at a wall (coupling.surface_inset)"));
+    CHECK(contains(on.out, "stops 0.30 r0 from its surface"));
+    const Result off = run("info " + scene + " --set coupling.surface_inset=false");
+    CHECK(contains(off.out, "on their faces (coupling.surface_inset false)"));
+    CHECK(contains(off.out, "stops 0.45 r0 from its surface"));
+    const Result wrong_type = run("info " + scene + " --set coupling.surface_inset=yes");
+    CHECK(wrong_type.code != 0);
+    CHECK(contains(wrong_type.err, "coupling.surface_inset"));
+}
+
 TEST_CASE("info: interface tension is a stage among the non-pressure forces, when an object has it") {
     const std::string scene = tiny_scene_with_box("tension.json");
     const nlohmann::json on = info_json(scene, "--set objects.0.interface_tension=0.2");

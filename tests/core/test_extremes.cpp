@@ -156,11 +156,12 @@ TEST_CASE("the extremes, elastic: 500 kg/m3 thrown into a pool at 5 m/s, CFL 0.4
 }
 
 // What the rigid objects' answer inside PCISPH (coupling.strong) holds: without it the
-// 2,000 kg/m3 cube at CFL 1, met in every iteration as if it kept its velocity through the step,
-// ends 0.07 m above the floor (measured on the EPYC VM).
-TEST_CASE("without coupling.strong the 2,000 kg/m3 rigid cube at CFL 1 ends above the floor") {
-    const Throw t = throw_into_pool(SolidKind::kRigid, 2000, 1.0f, false);
-    MESSAGE("centre " << t.centroid_y << " m (on the floor: " << kCube / 2 << " m)");
+// 10,000 kg/m3 cube, met in every iteration as if it kept its velocity through the step, gains
+// energy where it lands (measured on the EPYC VM: 19% of the scene's at CFL 0.4, 10% at CFL 1;
+// none with it).
+TEST_CASE("without coupling.strong the 10,000 kg/m3 rigid cube gains energy landing on the floor") {
+    const Throw t = throw_into_pool(SolidKind::kRigid, 10000, 0.4f, false);
+    MESSAGE("energy gain " << t.energy_gain << " of the scene's; centre " << t.centroid_y << " m");
     CHECK(t.finished);
-    CHECK(t.centroid_y > kCube / 2 + kR0);
+    CHECK(t.energy_gain > 0.05);
 }

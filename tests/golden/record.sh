@@ -13,7 +13,7 @@ if [[ ! -f "tests/golden/$name.set" ]]; then
 import json, sys
 scene = json.load(open(sys.argv[1]))
 for section, key in [("boundary", "correction"), ("coupling", "two_way"), ("coupling", "correction"),
-                     ("coupling", "predict_solids"), ("coupling", "strong")]:
+                     ("coupling", "predict_solids"), ("coupling", "strong"), ("coupling", "surface_inset")]:
     value = scene.get(section, {}).get(key, True)
     print(f"{section}.{key}={'true' if value else 'false'}")
 PY

@@ -144,6 +144,26 @@ TEST_CASE("a body at rest with no forces stays at rest for 1000 steps") {
     CHECK(drift < 1e-5 * r0);
 }
 
+TEST_CASE("a rigid object's surface particles sit inside its faces, and a bad inset is refused") {
+    SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, Real(0.002), Vec3{0, 0, 0});
+    add(s, box_mesh(Vec3{0.2f, 0.2f, 0.2f}, Vec3{0.5f, 0.5f, 0.5f}), solid(SolidKind::kRigid));
+    add(s, box_mesh(Vec3{0.2f, 0.2f, 0.2f}, Vec3{0.2f, 0.2f, 0.2f}), solid(SolidKind::kElastic));
+    const Real r0 = s.params.fluid.spacing;
+    // The rigid box's SBPs the walls' gap (0.6 r0 at h = 2 r0) inside its faces, the elastic box's
+    // on them (coupling.surface_inset).
+    const SolidSetup &rigid = s.solids[0], &elastic = s.solids[1];
+    REQUIRE(rigid.sbp_inset.size() == rigid.sbp.size());
+    for (const Real inset : rigid.sbp_inset) CHECK(inset == doctest::Approx(0.6 * r0).epsilon(0.05));
+    for (const Real inset : elastic.sbp_inset) CHECK(inset == 0);
+    CHECK(build_lsm_layout(s).sbp_inset.size() == rigid.sbp.size() + elastic.sbp.size());
+    SimulationSetup wrong_length = s;
+    wrong_length.solids[0].sbp_inset.pop_back();
+    CHECK_THROWS_WITH_AS(build_lsm_layout(wrong_length), doctest::Contains("SBP lists differ in length"), InputError);
+    SimulationSetup too_deep = s;
+    too_deep.solids[0].sbp_inset[0] = r0;
+    CHECK_THROWS_WITH_AS(build_lsm_layout(too_deep), doctest::Contains("inset is outside [0, r0)"), InputError);
+}
+
 TEST_CASE("goals reproduce a rigid translation plus rotation of the rest shape") {
     for (SolidKind kind : {SolidKind::kElastic, SolidKind::kRigid}) {
         SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, Real(0.01), Vec3{0, 0, 0});
@@ -263,10 +283,15 @@ TEST_CASE("spinning rigid body: GPs follow the rigid fit of the IBPs, SBPs their
                     xb = xb + b[std::size_t(j)] * d3(x[body.gp[std::size_t(corner[std::size_t(j)])]]);
                     vb = vb + b[std::size_t(j)] * d3(v[body.gp[std::size_t(corner[std::size_t(j)])]]);
                 }
-                // Three float products and two sums of values below 1 m (or 1 m/s), each rounding
-                // by at most half an ulp, 2^-25: at most 5 · 2^-25 = 1.5e-7.
-                const double combination_rounding = 5 * std::ldexp(1.0, -25);
-                worst_sbp = std::max(worst_sbp, (d3(x[body.sbp[k]]) - xb).norm() / combination_rounding);
+                // The SBP sits its inset inside the triangle along the normal the step computed
+                // (sampling/surface_inset.hpp; far from the walls, not faded).
+                const double inset = body.sbp_inset.empty() ? 0.0 : double(body.sbp_inset[k]);
+                const V3d set_in = xb - inset * d3(normal[k]);
+                // Four float products and three sums of values below 1 m (or 1 m/s; the inset
+                // times a unit normal), each rounding by at most half an ulp, 2^-25: at most
+                // 7 · 2^-25 = 2.1e-7 (the velocity: 5 · 2^-25).
+                const double combination_rounding = 7 * std::ldexp(1.0, -25);
+                worst_sbp = std::max(worst_sbp, (d3(x[body.sbp[k]]) - set_in).norm() / combination_rounding);
                 worst_sbp_velocity = std::max(worst_sbp_velocity, (d3(v[body.sbp[k]]) - vb).norm() / combination_rounding);
                 // Normal: the deformed triangle's, oriented like the rest normal n0.
                 const V3d c0 = d3(x[body.gp[std::size_t(corner[0])]]), c1 = d3(x[body.gp[std::size_t(corner[1])]]),
