@@ -91,7 +91,6 @@ struct LsmHostLayout {
     // SBPs
     std::vector<SbpLink> sbp;
     std::vector<Vec3> sbp_normal;
-    std::vector<Real> sbp_inset;
     std::vector<LsmObjectParams> objects;
 
     std::size_t region_count() const { return region_mass.size(); }
@@ -327,7 +326,6 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
                 throw InputError("solid '" + s.name + "': an SBP's inset is outside [0, r0)");
             L.sbp.push_back(link);
             L.sbp_normal.push_back(s.sbp_normal[k]);
-            L.sbp_inset.push_back(link.inset);
         }
     }
 }

@@ -575,8 +575,9 @@ class SolidBodies final : public Module {
     // read in the gathers): each one's where the scene starts, faded near the walls as the scene
     // builder placed it and each step will.
     void upload_surface_insets(const LsmHostLayout& L, const SimulationSetup& setup) {
-        const bool any = std::any_of(L.sbp_inset.begin(), L.sbp_inset.end(), [](Real inset) { return inset > Real(0); });
-        if (!any) {
+        Real largest = 0;
+        for (const SbpLink& link : L.sbp) largest = std::max(largest, link.inset);
+        if (!(largest > Real(0))) {
             sbp_inset_.resize(0);
             largest_inset_ = 0;
             return;
@@ -592,7 +593,7 @@ class SolidBodies final : public Module {
                                    inset_fade_);
         }
         sbp_inset_.upload(start);
-        largest_inset_ = *std::max_element(L.sbp_inset.begin(), L.sbp_inset.end());
+        largest_inset_ = largest;
     }
 
     // Visits each state array of `self` (a SolidBodies, const or not) with its block name.

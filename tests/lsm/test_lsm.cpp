@@ -155,7 +155,9 @@ TEST_CASE("a rigid object's surface particles sit inside its faces, and a bad in
     REQUIRE(rigid.sbp_inset.size() == rigid.sbp.size());
     for (const Real inset : rigid.sbp_inset) CHECK(inset == doctest::Approx(0.6 * r0).epsilon(0.05));
     for (const Real inset : elastic.sbp_inset) CHECK(inset == 0);
-    CHECK(build_lsm_layout(s).sbp_inset.size() == rigid.sbp.size() + elastic.sbp.size());
+    const LsmHostLayout layout = build_lsm_layout(s);
+    REQUIRE(layout.sbp.size() == rigid.sbp.size() + elastic.sbp.size());
+    for (std::size_t k = 0; k < rigid.sbp.size(); ++k) CHECK(layout.sbp[k].inset == rigid.sbp_inset[k]);
     SimulationSetup wrong_length = s;
     wrong_length.solids[0].sbp_inset.pop_back();
     CHECK_THROWS_WITH_AS(build_lsm_layout(wrong_length), doctest::Contains("SBP lists differ in length"), InputError);
