@@ -98,10 +98,11 @@ struct CouplingData {
     // SBPs' face points.
     const Real* sbp_eta = nullptr;
     SbpFaces faces;
-    // Inside PCISPH (coupling.strong): only rigid objects' slots are gathered (each slot's object,
-    // and the objects' parameters); null: every slot.
+    // Inside PCISPH (coupling.strong): only the slots of the objects that answer there (rigid
+    // ones and cloths: LsmObjectParams::answers) are gathered (each slot's object, and the
+    // objects' parameters); null: every slot.
     const std::int32_t* slot_object = nullptr;
-    const LsmObjectParams* rigid_only = nullptr;
+    const LsmObjectParams* answering_only = nullptr;
 };
 
 // The pairs the fluid summed: in grid mode all in the 27 cells (the relation is symmetric:
@@ -156,7 +157,7 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
     const Real friction_scale = -c.mass * c.wall_viscosity / c.rest_density;  // -m μ_w / ρ0
     const bool lists = pairs.list_radius2 > Real(0);
     parallel_for(device, "coupling_reaction", std::size_t(d.ibp_count) + d.sbp_count, [=] MW_HD(std::size_t s) {
-        if (d.rigid_only && !d.rigid_only[d.slot_object[s]].rigid) return;
+        if (d.answering_only && !d.answering_only[d.slot_object[s]].answers()) return;
         const std::uint32_t b = d.store_of_slot[s];
         // A solid particle that left the grid (counted as lost) meets no fluid.
         if (b < pairs.fluid_end || b >= pairs.solid_end) {
@@ -202,7 +203,7 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
 // Each IBP's force: its own reaction and its shares of the SBPs' (see the top of the file).
 inline void gather_solid_forces(const DeviceContext& device, const CouplingData d) {
     parallel_for(device, "coupling_to_ibps", d.ibp_count, [=] MW_HD(std::size_t s) {
-        if (d.rigid_only && !d.rigid_only[d.slot_object[s]].rigid) return;
+        if (d.answering_only && !d.answering_only[d.slot_object[s]].answers()) return;
         Vec3 f = d.reaction[s];
         for (std::uint32_t e = d.share_offsets[s]; e < d.share_offsets[s + 1]; ++e)
             f += d.share_weight[e] * d.reaction[d.ibp_count + d.share_sbp[e]];
@@ -224,8 +225,8 @@ inline void gather_solid_forces(const DeviceContext& device, const CouplingData 
 // added-mass instability). Aitken's Δ² relaxation (Küttler & Wall 2008) sets each object's step
 // from its last two residuals r = G - a: a += ω r,
 // ω_k = -ω_{k-1} r_{k-1}·(r_k - r_{k-1}) / |r_k - r_{k-1}|², within [kMinRelaxation, 1], from
-// kFirstRelaxation (the angular part scaled by the object's half-diagonal). Only the rigid
-// objects' particles are gathered inside PCISPH (CouplingData::rigid_only).
+// kFirstRelaxation (the angular part scaled by the object's half-diagonal). Only the answering
+// objects' particles are gathered inside PCISPH (CouplingData::answering_only).
 // Elastic objects are met at their mean velocity, without an answer: measured, the same answer
 // (their mean acceleration) left the heavy elastic cubes at CFL 1 gaining energy or running away
 // at the floor in ways that changed with any detail of the relaxation (docs/coupling.md).
@@ -330,6 +331,164 @@ inline void relax_object_accelerations(const DeviceContext& device, ObjectIbps o
         next[o].angular = now.angular + omega * (target.angular - now.angular);
         next[o].centre = target.centre;
     });
+}
+
+// Strong coupling of a cloth (LsmObjectParams::nodal): its nodes weigh less than the fluid they
+// hold up, and answered after the solve, they overshoot (a 300 kg/m3 cloth under a stream rang up
+// to 60 m/s and blew up at CFL steps, and at a fixed 1 ms; it held at 0.5 ms). Inside PCISPH each
+// node answers as LSM will move it: the fluid's forces F (each IBP's reaction and its shares of
+// the SBPs') act through the regions (lsm.hpp: region r accelerates by Σ F_j / n_j / M_r over
+// its members j, each force split among the n_j regions that hold j), and a node by the mean of
+// its regions' accelerations (their rotation left out). Its expected acceleration is a = o + that,
+// o what the last step gave it apart from the fluid (gravity, the shape matching's pull, damping,
+// the walls: its velocity change over the last step less the fluid's part of it; gravity alone in
+// the first step), so that a cloth held up by its own stiffness is not expected to fall. Pinned
+// nodes expect nothing. A node is not expected past the domain's walls (the box shrunk by its
+// margin). The expected accelerations move toward their targets by one Aitken ω per cloth, as the
+// rigid objects' do (relax_object_accelerations). An SBP expects its triangle's corners'
+// accelerations, by its barycentric weights.
+struct NodeResponse {
+    const std::uint32_t* object_begin = nullptr;  // per object, its first IBP slot (and one past the last)
+    const LsmObjectParams* params = nullptr;      // per object
+    const std::int32_t* slot_object = nullptr;    // per IBP and SBP slot
+    const std::uint32_t* store_of_slot = nullptr;
+    const std::uint8_t* pinned = nullptr;         // per IBP slot
+    const Vec3* force = nullptr;                  // per IBP slot: the fluid's, this iteration
+    // The regions (lsm_regions.hpp): a cloth's region r is centred on IBP slot r.
+    const std::uint32_t* regions_begin = nullptr;  // per IBP slot, into member_index (its regions)
+    const std::uint32_t* regions_end = nullptr;
+    const std::uint32_t* region_offsets = nullptr;  // per region, into member_index (its members)
+    const std::uint32_t* region_end = nullptr;
+    const std::uint32_t* member_index = nullptr;
+    const Real* region_mass = nullptr;
+    Vec3* region_acceleration = nullptr;          // per IBP slot (a cloth's region), scratch
+    Vec3* fluid_acceleration = nullptr;           // per IBP slot: the mean of its regions', scratch
+    const Vec3* other = nullptr;                  // per IBP slot: o above
+    Vec3* target_residual = nullptr;              // per IBP slot: this iteration's r = target - a
+    Vec3* last_residual = nullptr;                // per IBP slot: the last iteration's
+    ResponseRelaxation* relaxation = nullptr;     // per object: ω
+    const SbpLink* sbp = nullptr;                 // per SBP: its triangle of GPs
+    const std::uint32_t* gp_offsets = nullptr;    // per GP: its IBP links and weights
+    const std::uint32_t* gp_links = nullptr;
+    const Real* gp_weights = nullptr;
+    std::uint32_t ibp_count = 0, sbp_count = 0;
+    std::size_t object_count = 0;
+};
+
+// The acceleration `force` gives each cloth node through its regions (n.fluid_acceleration).
+inline void node_fluid_accelerations(const DeviceContext& device, const NodeResponse n, const Vec3* force) {
+    parallel_for(device, "strong_coupling_nodes_regions", n.ibp_count, [=] MW_HD(std::size_t r) {
+        if (!n.params[n.slot_object[r]].nodal) return;
+        Vec3 f{0, 0, 0};
+        for (std::uint32_t k = n.region_offsets[r]; k < n.region_end[r]; ++k) {
+            const std::uint32_t j = n.member_index[k];
+            f += force[j] / Real(n.regions_end[j] - n.regions_begin[j]);
+        }
+        n.region_acceleration[r] = f / n.region_mass[r];
+    });
+    parallel_for(device, "strong_coupling_nodes_mean", n.ibp_count, [=] MW_HD(std::size_t s) {
+        if (!n.params[n.slot_object[s]].nodal) return;
+        Vec3 a{0, 0, 0};
+        const std::uint32_t begin = n.regions_begin[s], end = n.regions_end[s];
+        for (std::uint32_t k = begin; k < end; ++k) a += n.region_acceleration[n.member_index[k]];
+        n.fluid_acceleration[s] = end > begin ? a / Real(end - begin) : a;
+    });
+}
+
+// Once a step, before PCISPH, with n.force the last step's: o per node, the whole acceleration of
+// the last step (the solve's first guess, `warm`), and the velocity it starts this step with.
+inline void measure_node_accelerations(const DeviceContext& device, const NodeResponse n, View<const Vec3> velocity,
+                                       Vec3* other, Vec3* warm, Vec3* last_velocity, Vec3 gravity, Real last_dt) {
+    node_fluid_accelerations(device, n, n.force);
+    parallel_for(device, "strong_coupling_nodes_measure", n.ibp_count, [=] MW_HD(std::size_t s) {
+        if (!n.params[n.slot_object[s]].nodal) return;
+        const Vec3 v = velocity[n.store_of_slot[s]];
+        const Vec3 total = last_dt > Real(0) ? (Real(1) / last_dt) * (v - last_velocity[s]) : gravity + n.fluid_acceleration[s];
+        other[s] = total - n.fluid_acceleration[s];
+        warm[s] = total;
+        last_velocity[s] = v;
+    });
+}
+
+// Each SBP of a cloth: its corners' expected accelerations (their GPs' linked nodes).
+inline void interpolate_node_responses(const DeviceContext& device, const NodeResponse n, Vec3* accel) {
+    parallel_for(device, "strong_coupling_nodes_sbp", n.sbp_count, [=] MW_HD(std::size_t k) {
+        if (!n.params[n.slot_object[n.ibp_count + k]].nodal) return;
+        const SbpLink link = n.sbp[k];
+        const Real b[3] = {link.bary.x, link.bary.y, link.bary.z};
+        Vec3 a{0, 0, 0};
+        for (int c = 0; c < 3; ++c)
+            for (std::uint32_t e = n.gp_offsets[link.corner[c]]; e < n.gp_offsets[link.corner[c] + 1]; ++e)
+                a += (b[c] * n.gp_weights[e]) * accel[n.gp_links[e]];
+        accel[n.ibp_count + k] = a;
+    });
+}
+
+// A new try: every node expected to move as in the last step (`warm`), the SBPs after them.
+inline void start_node_responses(const DeviceContext& device, const NodeResponse n, const Vec3* warm, Vec3* accel) {
+    parallel_for(device, "strong_coupling_nodes_start", n.ibp_count, [=] MW_HD(std::size_t s) {
+        if (!n.params[n.slot_object[s]].nodal) return;
+        accel[s] = n.pinned[s] ? Vec3{0, 0, 0} : warm[s];
+        n.last_residual[s] = Vec3{0, 0, 0};
+    });
+    parallel_for(device, "strong_coupling_nodes_start_objects", n.object_count, [=] MW_HD(std::size_t o) {
+        if (n.params[o].nodal) n.relaxation[o] = ResponseRelaxation{};
+    });
+    interpolate_node_responses(device, n, accel);
+}
+
+// One iteration's update of the cloths' expected accelerations: `accel` (met by this iteration)
+// into `next`, from this iteration's forces (n.force).
+inline void relax_node_accelerations(const DeviceContext& device, const NodeResponse n, View<const Vec3> position,
+                                     View<const Vec3> velocity, ResponseStep step, const Vec3* accel, Vec3* next) {
+    node_fluid_accelerations(device, n, n.force);
+    parallel_for(device, "strong_coupling_nodes_target", n.ibp_count, [=] MW_HD(std::size_t s) {
+        const LsmObjectParams params = n.params[n.slot_object[s]];
+        if (!params.nodal) return;
+        Vec3 target{0, 0, 0};
+        if (!n.pinned[s]) {
+            target = n.other[s] + n.fluid_acceleration[s];
+            // The walls: the node's shift dt (v + dt a) stays inside the box shrunk by its margin.
+            const std::uint32_t i = n.store_of_slot[s];
+            const Vec3 x = position[i], v = velocity[i];
+            const Real lo[3] = {step.domain_min.x + params.margin - x.x, step.domain_min.y + params.margin - x.y,
+                                step.domain_min.z + params.margin - x.z};
+            const Real hi[3] = {step.domain_max.x - params.margin - x.x, step.domain_max.y - params.margin - x.y,
+                                step.domain_max.z - params.margin - x.z};
+            const Real vv[3] = {v.x, v.y, v.z};
+            Real* g[3] = {&target.x, &target.y, &target.z};
+            const Real inverse_dt2 = Real(1) / (step.dt * step.dt);
+            for (int k = 0; k < 3; ++k) {
+                const Real shift = step.dt * vv[k] + step.dt * step.dt * *g[k];
+                if (shift < lo[k]) *g[k] = (lo[k] - step.dt * vv[k]) * inverse_dt2;
+                if (shift > hi[k]) *g[k] = (hi[k] - step.dt * vv[k]) * inverse_dt2;
+            }
+        }
+        n.target_residual[s] = target - accel[s];
+    });
+    parallel_for(device, "strong_coupling_nodes_aitken", n.object_count, [=] MW_HD(std::size_t o) {
+        if (!n.params[o].nodal) return;
+        ResponseRelaxation& state = n.relaxation[o];
+        Real omega = kFirstRelaxation;
+        if (state.omega > Real(0)) {
+            double dot_sum = 0, d2_sum = 0;
+            for (std::uint32_t s = n.object_begin[o]; s < n.object_begin[o + 1]; ++s) {
+                const Vec3 d = n.target_residual[s] - n.last_residual[s];
+                dot_sum += double(dot(n.last_residual[s], d));
+                d2_sum += double(norm2(d));
+            }
+            omega = d2_sum > 0 ? Real(-double(state.omega) * dot_sum / d2_sum) : state.omega;
+            omega = omega < kMinRelaxation ? kMinRelaxation : omega > Real(1) ? Real(1) : omega;
+        }
+        state.omega = omega;
+    });
+    parallel_for(device, "strong_coupling_nodes_update", n.ibp_count, [=] MW_HD(std::size_t s) {
+        if (!n.params[n.slot_object[s]].nodal) return;
+        const Vec3 r = n.target_residual[s];
+        next[s] = accel[s] + n.relaxation[n.slot_object[s]].omega * r;
+        n.last_residual[s] = r;
+    });
+    interpolate_node_responses(device, n, next);
 }
 
 MW_BACKEND_END

@@ -51,6 +51,11 @@ struct LsmObjectParams {
     Real friction = 0;      // wall friction
     Real margin = 0;        // IBPs stay this far inside the domain walls
     std::uint8_t rigid = 0; // 1 for a rigid object (one region), 0 for an elastic one
+    // 1 for a cloth: each node answers the fluid's pressure on its own inside PCISPH
+    // (coupling.strong; coupling.hpp, relax_node_accelerations), and PCISPH meets each of its
+    // particles at its own velocity.
+    std::uint8_t nodal = 0;
+    MW_HD bool answers() const { return rigid || nodal; }  // inside PCISPH, under coupling.strong
 };
 
 struct SbpLink {
@@ -91,6 +96,9 @@ struct LsmHostLayout {
     // SBPs
     std::vector<SbpLink> sbp;
     std::vector<Vec3> sbp_normal;
+    // Per SBP, 1 where the fluid meets it from both sides (cloth): the correction turns its normal
+    // to the side the fluid particle comes from. Empty when no object is two-sided.
+    std::vector<std::uint8_t> sbp_two_sided;
     std::vector<LsmObjectParams> objects;
 
     std::size_t region_count() const { return region_mass.size(); }
@@ -182,6 +190,36 @@ inline void build_elastic_regions(const std::vector<std::array<int, 3>>& lattice
             for (std::size_t c : touched) depth[c] = -1;
             touched.clear();
         }
+        std::sort(m.begin(), m.end());
+    }
+}
+
+// Members (local IBP indices, increasing) of the region centred on each IBP of one object whose
+// IBPs have no lattice: those within w links of it on the graph (CSR `offsets`, `links`; cloth:
+// the mesh's edges). Graph distance is symmetric, so membership is too, as on the lattice.
+inline void build_graph_regions(const std::vector<std::uint32_t>& offsets, const std::vector<std::uint32_t>& links,
+                                int w, std::vector<std::vector<std::uint32_t>>& members) {
+    const std::size_t n = offsets.empty() ? 0 : offsets.size() - 1;
+    members.assign(n, {});
+    std::vector<int> depth(n, -1);
+    for (std::size_t p = 0; p < n; ++p) {
+        std::vector<std::uint32_t>& m = members[p];
+        std::vector<std::uint32_t> frontier{std::uint32_t(p)};
+        depth[p] = 0;
+        m.push_back(std::uint32_t(p));
+        for (int d = 1; d <= w; ++d) {
+            std::vector<std::uint32_t> next;
+            for (std::uint32_t q : frontier)
+                for (std::uint32_t e = offsets[q]; e < offsets[q + 1]; ++e) {
+                    const std::uint32_t r = links[e];
+                    if (depth[r] >= 0) continue;
+                    depth[r] = d;
+                    next.push_back(r);
+                    m.push_back(r);
+                }
+            frontier.swap(next);
+        }
+        for (std::uint32_t q : m) depth[q] = -1;
         std::sort(m.begin(), m.end());
     }
 }
@@ -307,6 +345,7 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
         if (s.sbp_corners.size() != s.sbp.size() || s.sbp_barycentric.size() != s.sbp.size() ||
             s.sbp_normal.size() != s.sbp.size() || (!s.sbp_inset.empty() && s.sbp_inset.size() != s.sbp.size()))
             throw InputError("solid '" + s.name + "': SBP lists differ in length");
+        const std::size_t first_sbp = L.sbp.size();
         for (std::size_t k = 0; k < s.sbp.size(); ++k) {
             check_index(s.sbp[k], "sbp", s.name);
             L.scene_index[L.ibp_count + sbp_base[o] + k] = s.sbp[k];
@@ -327,6 +366,9 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
             L.sbp.push_back(link);
             L.sbp_normal.push_back(s.sbp_normal[k]);
         }
+        if (s.kind == SolidKind::kCloth) L.sbp_two_sided.resize(first_sbp, 0);
+        if (s.kind == SolidKind::kCloth || !L.sbp_two_sided.empty())
+            L.sbp_two_sided.resize(L.sbp.size(), s.kind == SolidKind::kCloth ? 1 : 0);
     }
 }
 
@@ -378,7 +420,13 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         const SolidSetup& s = setup.solids[o];
         if (s.kind == SolidKind::kStatic) continue;
         if (s.ibp.empty()) throw InputError("solid '" + s.name + "' has no inner particles (IBPs); make it larger or decrease the spacing");
-        if (s.lattice.size() != s.ibp.size()) throw InputError("solid '" + s.name + "': lattice and ibp lists differ in length");
+        const bool graph = s.kind == SolidKind::kCloth;
+        if (!graph && s.lattice.size() != s.ibp.size())
+            throw InputError("solid '" + s.name + "': lattice and ibp lists differ in length");
+        if (graph && (s.ibp_graph_offsets.size() != s.ibp.size() + 1 || s.ibp_graph_offsets.back() != s.ibp_graph_links.size()))
+            throw InputError("solid '" + s.name + "': malformed IBP graph");
+        if (!s.ibp_mass.empty() && s.ibp_mass.size() != s.ibp.size())
+            throw InputError("solid '" + s.name + "': IBP mass list has the wrong length");
         if (!s.pinned.empty() && s.pinned.size() != s.ibp.size()) throw InputError("solid '" + s.name + "': pinned list has the wrong length");
         if (!(s.stiffness > 0 && s.stiffness <= 1)) throw InputError("solid '" + s.name + "': stiffness α must be in (0, 1]");
         if (!(s.density > 0) || !(s.spacing > 0)) throw InputError("solid '" + s.name + "': density and spacing must be > 0");
@@ -390,19 +438,27 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         P.friction = s.wall_friction;
         P.margin = Real(0.5) * s.spacing;
         P.rigid = s.kind == SolidKind::kRigid ? 1 : 0;
+        P.nodal = s.kind == SolidKind::kCloth ? 1 : 0;
         const Real mass = s.density * s.spacing * s.spacing * s.spacing;
         const std::size_t base = ibp_base[o];
         for (std::size_t k = 0; k < s.ibp.size(); ++k) {
             check_index(s.ibp[k], "ibp", s.name);
             L.scene_index[base + k] = s.ibp[k];
             L.ibp_rest[base + k] = setup.position[s.ibp[k]];
-            L.ibp_mass[base + k] = mass;
+            L.ibp_mass[base + k] = s.ibp_mass.empty() ? mass : s.ibp_mass[k];
+            if (!(L.ibp_mass[base + k] > Real(0))) throw InputError("solid '" + s.name + "': an IBP's mass is not positive");
             L.ibp_object[base + k] = std::int32_t(o);
             L.ibp_pinned[base + k] = s.pinned.empty() ? 0 : s.pinned[k];
         }
-        if (s.kind == SolidKind::kElastic) {
+        if (s.kind != SolidKind::kRigid) {
             std::vector<std::vector<std::uint32_t>> local;
-            lsm_detail::build_elastic_regions(s.lattice, s.region_half_width, local);
+            if (graph) {
+                for (std::uint32_t link : s.ibp_graph_links)
+                    if (link >= s.ibp.size()) throw InputError("solid '" + s.name + "': IBP graph link out of range");
+                lsm_detail::build_graph_regions(s.ibp_graph_offsets, s.ibp_graph_links, s.region_half_width, local);
+            } else {
+                lsm_detail::build_elastic_regions(s.lattice, s.region_half_width, local);
+            }
             for (std::size_t k = 0; k < local.size(); ++k) {
                 for (std::uint32_t& m : local[k]) m += std::uint32_t(base);
                 region_members[base + k] = std::move(local[k]);

@@ -98,7 +98,7 @@ inline void predict_positions(const DeviceContext& device, std::size_t fluid_cou
         const Vec3 v = velocity[i] + dt * a;
         Vec3 x = position[i] + dt * v;
         if (solids.active())
-            x = solids.correct_predicted(static_cast<std::uint32_t>(i), x, velocity[i], position, velocity);
+            x = solids.correct_predicted(static_cast<std::uint32_t>(i), x, position[i], velocity[i], position, velocity);
         predicted[i] = walls.correct_predicted(x, v);
     });
 }
@@ -119,7 +119,8 @@ struct ObjectResponse {
 // accelerations the solve expects (coupling.strong); a soft object's at its object's mean
 // velocity, since its own carries the object's vibration, which the fluid's pressure would answer
 // (the floating jelly's pool ran three times as fast; docs/coupling.md, "Solids met where they
-// will be"). Static boundary particles stay put.
+// will be"). A cloth's particles are taken ahead each at its own velocity, changed by the
+// acceleration the solve expects of it (coupling.strong). Static boundary particles stay put.
 struct SolidLookahead {
     const Vec3* velocity = nullptr;            // the store's; null: every boundary particle where it is
     const Vec3* object_velocity = nullptr;        // per object, its mean velocity
@@ -129,11 +130,21 @@ struct SolidLookahead {
     // Per object, the accelerations the solve expects the step to give a rigid object (gravity and
     // the fluid's pressure, coupling.strong; coupling.hpp); null: none, it keeps its velocity.
     const ObjectResponse* object_response = nullptr;
+    // Per IBP and SBP slot, the acceleration the solve expects the step to give a cloth's particle
+    // (coupling.strong; coupling.hpp, relax_node_accelerations); null: none, it keeps its velocity.
+    const Vec3* slot_acceleration = nullptr;
     std::size_t end = 0;                       // the moving solids' boundary particles end here
     Real dt = 0;
     MW_INLINE Vec3 place(std::uint32_t b, Vec3 xb) const {
         if (!velocity || b >= end) return xb;
-        const std::int32_t o = slot_object[solid_slot[b]];
+        const std::int32_t slot = solid_slot[b];
+        const std::int32_t o = slot_object[slot];
+        if (objects[o].nodal) {
+            // A cloth's particles move apart (its sag is no vibration about a mean): each at its own velocity.
+            Vec3 v = velocity[b];
+            if (slot_acceleration) v += dt * slot_acceleration[slot];
+            return xb + dt * v;
+        }
         if (objects[o].rigid) {
             Vec3 v = velocity[b];
             if (object_response) {

@@ -107,7 +107,9 @@ class SolidBodies final : public Module {
         has_rigid_ = false;
         has_elastic_ = false;
         bool body_damping = false;
+        has_cloth_ = false;
         for (const auto& o : L.objects) {
+            has_cloth_ = has_cloth_ || o.nodal;
             has_rigid_ = has_rigid_ || o.rigid;
             has_elastic_ = has_elastic_ || !o.rigid;
             body_damping = body_damping || o.body_damping_rate > Real(0);
@@ -120,6 +122,7 @@ class SolidBodies final : public Module {
         gp_weights_.upload(L.gp_weights);
         sbp_.upload(L.sbp);
         sbp_normal_.upload(L.sbp_normal);
+        sbp_two_sided_.upload(L.sbp_two_sided);
         upload_surface_insets(L, setup);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
@@ -381,6 +384,32 @@ class SolidBodies final : public Module {
     }
 
     // Each object's IBP slots and their masses (the strong coupling's per-object sums).
+    // What the cloths' answer inside PCISPH reads (coupling.hpp, NodeResponse), less its own arrays.
+    NodeResponse node_response() const {
+        NodeResponse n;
+        n.object_begin = object_ibp_begin_.view().data();
+        n.params = objects_.view().data();
+        n.slot_object = object_.view().data();
+        n.store_of_slot = store_of_slot_.view().data();
+        n.pinned = pinned_.view().data();
+        n.force = force_.view().data();
+        n.regions_begin = regions_begin_.view().data();
+        n.regions_end = regions_end_.view().data();
+        n.region_offsets = region_offsets_.view().data();
+        n.region_end = region_end_.view().data();
+        n.member_index = member_index_.view().data();
+        n.region_mass = region_mass_.view().data();
+        n.sbp = sbp_.view().data();
+        n.gp_offsets = gp_offsets_.view().data();
+        n.gp_links = gp_links_.view().data();
+        n.gp_weights = gp_weights_.view().data();
+        n.ibp_count = static_cast<std::uint32_t>(ibp_count_);
+        n.sbp_count = static_cast<std::uint32_t>(sbp_count_);
+        n.object_count = object_count_;
+        return n;
+    }
+    bool has_cloth() const { return has_cloth_; }
+
     ObjectIbps object_ibps() const {
         ObjectIbps o;
         o.begin = object_ibp_begin_.view().data();
@@ -417,6 +446,7 @@ class SolidBodies final : public Module {
         c.solid_slot = solid_slot_->cview();
         c.sbp_normal = sbp_normal_.view().data();
         c.sbp_inset = sbp_faces().inset;
+        if (!sbp_two_sided_.empty()) c.sbp_two_sided = sbp_two_sided_.view().data();
         c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
         c.sbp_count = static_cast<std::uint32_t>(sbp_count_);
         c.band = band;
@@ -496,7 +526,7 @@ class SolidBodies final : public Module {
                rotation_.bytes() + rotation_matrix_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
                region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
-               sbp_.bytes() + sbp_normal_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
+               sbp_.bytes() + sbp_normal_.bytes() + sbp_two_sided_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
                object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes() +
                body_motion_.bytes();
@@ -634,6 +664,7 @@ class SolidBodies final : public Module {
     bool predicts_ = false;
     std::size_t ibp_count_ = 0, sbp_count_ = 0, gp_count_ = 0, members_total_ = 0, object_count_ = 0;
     bool has_rigid_ = false;  // any rigid object (lsm_rigid_walls)
+    bool has_cloth_ = false;  // any cloth (its nodes answer inside PCISPH)
     bool has_elastic_ = false;  // any elastic object (substeps())
     Real substep_ = 0;          // solver.solid_substep
     DeviceArray<Vec3> wall_impulse_;  // per IBP of a rigid object, its walls' impulses this step
@@ -665,6 +696,7 @@ class SolidBodies final : public Module {
     DeviceArray<Real> gp_weights_;
     DeviceArray<SbpLink> sbp_;
     DeviceArray<Vec3> sbp_normal_;
+    DeviceArray<std::uint8_t> sbp_two_sided_;  // empty: no two-sided SBP (cloth)
     DeviceArray<Real> sbp_inset_;  // m, by SBP index, this step's (faded); empty: every SBP on its face
     Real inset_fade_ = 0;          // m (interpolate_surface)
     Real largest_inset_ = 0;       // m

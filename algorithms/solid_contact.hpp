@@ -75,6 +75,7 @@ struct SolidContactData {
     Vec3* sbp_impulse = nullptr;             // per SBP, what it got in this step (two-way only)
     Real slip = 1;                           // ∂: 0 no-slip, 1 free slip
     Real fluid_inverse_mass = 0;             // 1 / m_i
+    Real dt = 0;                             // the step: a particle started it at x - dt v
 };
 
 // Per fluid particle: the corrected position and velocity into (out_position, out_velocity) —
@@ -87,8 +88,8 @@ inline void correct_fluid_at_solids(const DeviceContext& device, std::size_t flu
                                     const SolidContactData d, const WallContact walls) {
     parallel_for(device, "solid_contact_fluid", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 x = position[i], v = velocity[i];
-        const VirtualBoundary k = d.surface.collide(static_cast<std::uint32_t>(i), x, position, velocity,
-                                                    d.sbp_inverse_mass);
+        const VirtualBoundary k = d.surface.collide(static_cast<std::uint32_t>(i), x, x - d.dt * v, position,
+                                                    velocity, d.sbp_inverse_mass);
         Vec3 xc = x, vc = v, impulse{0, 0, 0};
         Real depth = 0;
         if (d.surface.collides(k, x, v, depth)) {

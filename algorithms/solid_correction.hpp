@@ -53,8 +53,9 @@ class SolidCorrection final : public Module {
     void correct(StepContext& step) {
         ParticleStore& store = state_.store;
         const std::size_t fluid_count = step.ranges.fluid_end;
-        const SolidContactData contact =
+        SolidContactData contact =
             solids_.contact(step.solid_surface, state_.params.coupling.slip, state_.fluid.mass, impulse_per_weight_.view().data());
+        contact.dt = step.dt;
         if (solids_.contact_takes_impulses()) {
             View<Vec3> corrected_position = fluid_.scratch_after_integration(0);
             View<Vec3> corrected_velocity = fluid_.scratch_after_integration(1);

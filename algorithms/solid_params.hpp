@@ -8,7 +8,9 @@
 
 namespace mw {
 
-enum class SolidKind { kElastic, kRigid, kStatic };
+// Cloth (docs/cloth.md): one layer of particles on an open sheet mesh, shape-matched over the
+// k-rings of its vertices, met by the fluid from both sides.
+enum class SolidKind { kElastic, kRigid, kStatic, kCloth };
 
 struct SolidParams {
     SolidKind kind = SolidKind::kElastic;
@@ -36,8 +38,10 @@ inline const ParamTable<SolidParams>& solid_keys() {
         ParamTable<T> t;
         t.push_back(choice_key<T, SolidKind>(
             "objects[]", "kind", member(&T::kind),
-            {{"elastic", SolidKind::kElastic}, {"rigid", SolidKind::kRigid}, {"static", SolidKind::kStatic}},
-            "elastic (LSM regions), rigid (one region) or static (a fixed boundary)"));
+            {{"elastic", SolidKind::kElastic}, {"rigid", SolidKind::kRigid}, {"static", SolidKind::kStatic},
+             {"cloth", SolidKind::kCloth}},
+            "elastic (LSM regions), rigid (one region), static (a fixed boundary) or cloth (one layer on an open "
+            "sheet, docs/cloth.md)"));
         t.push_back(number_key<T>("objects[]", "density", member(&T::density), ParamRange::positive(), "kg/m3",
                                   "the solid's density"));
         t.push_back(number_key<T>("objects[]", "interface_tension", member(&T::interface_tension),
@@ -67,7 +71,7 @@ inline const ParamTable<SolidParams>& solid_keys() {
         t.push_back(number_key<T>("objects[]", "latent_heat", member(&T::latent_heat), ParamRange::non_negative(),
                                   "J/kg", "heat absorbed at the melting point before a particle melts"));
         t.push_back(integer_key<T>("objects[].lsm", "w", member(&T::region_half_width), 1, 8,
-                                   "region half-width: a region holds the lattice particles within w links"));
+                                   "region half-width: a region holds the lattice particles within w links (cloth: the mesh's w-ring)"));
         t.push_back(number_key<T>("objects[].lsm", "alpha", member(&T::stiffness), ParamRange{0, 1, true, false}, "",
                                   "stiffness: the share of the way to the goal taken each step"));
         t.push_back(number_key<T>("objects[].lsm", "damping", member(&T::damping), ParamRange::non_negative(), "1/s",

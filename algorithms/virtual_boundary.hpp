@@ -89,6 +89,9 @@ struct SolidSurface {
     View<const std::int32_t> solid_slot;
     const Vec3* sbp_normal = nullptr;  // by SBP index; null: no correction against solids
     const Real* sbp_inset = nullptr;   // by SBP index (solid_face.hpp); null: on the face
+    // By SBP index, 1 for an SBP the fluid meets from both sides (cloth); null: none is. Its
+    // normal is turned toward the side the fluid particle comes from (`from` of collide).
+    const std::uint8_t* sbp_two_sided = nullptr;
     std::uint32_t ibp_count = 0, sbp_count = 0;  // SBP k has solid slot ibp_count + k
     Real band = 0;   // c, m
     Real reach = 0;  // r0, m
@@ -105,8 +108,11 @@ struct SolidSurface {
 
     // The virtual particle fluid particle i at x faces: a gather over the SBPs around the cell i
     // was sorted into at this step's build (neighbor_grid.hpp), from the store's positions and
-    // velocities. A virtual particle whose normals cancel is none.
-    MW_INLINE VirtualBoundary collide(std::uint32_t i, Vec3 x, View<const Vec3> position,
+    // velocities. A virtual particle whose normals cancel is none. `from`: where i was at the
+    // start of the step, which decides the side of a two-sided SBP it meets. The paper turns a
+    // cloth's normal along x_is = x_i - x_s; a particle that has already crossed the sheet in this
+    // step would then be pushed on through it.
+    MW_INLINE VirtualBoundary collide(std::uint32_t i, Vec3 x, Vec3 from, View<const Vec3> position,
                                       View<const Vec3> velocity, const Real* sbp_inverse_mass) const {
         VirtualBoundary k;
         if (fluid_near_solid && !fluid_near_solid[i]) return k;
@@ -124,7 +130,8 @@ struct SolidSurface {
             k.weight += w;
             k.position += w * xs;
             k.velocity += w * velocity[j];
-            normal_sum += w * sbp_normal[s];
+            const Vec3 n = sbp_normal[s];
+            normal_sum += (sbp_two_sided && sbp_two_sided[s] && dot(n, from - sbp) < Real(0) ? -w : w) * n;
             if (sbp_inverse_mass) k.inverse_mass += w * sbp_inverse_mass[s];
         });
         const Real length = norm(normal_sum);
@@ -146,11 +153,11 @@ struct SolidSurface {
     }
 
     // The position rule alone, for a PCISPH prediction x* of a particle that started the step at
-    // velocity v (against the SBPs where they are at the start of the step, where the density
-    // sees them): x* moves along n_k until it is c in front of k's surface.
-    MW_INLINE Vec3 correct_predicted(std::uint32_t i, Vec3 x, Vec3 v, View<const Vec3> position,
+    // `from` with velocity v (against the SBPs where they are at the start of the step, where the
+    // density sees them): x* moves along n_k until it is c in front of k's surface.
+    MW_INLINE Vec3 correct_predicted(std::uint32_t i, Vec3 x, Vec3 from, Vec3 v, View<const Vec3> position,
                                      View<const Vec3> velocity) const {
-        const VirtualBoundary k = collide(i, x, position, velocity, nullptr);
+        const VirtualBoundary k = collide(i, x, from, position, velocity, nullptr);
         Real depth = 0;
         return collides(k, x, v, depth) ? x + (band - depth) * k.normal : x;
     }

@@ -294,12 +294,17 @@ void print_coupling(const InfoFacts& f) {
         std::printf("            velocity-position correction against them off (coupling.correction false)\n");
     if (c.predict_solids) {
         std::printf("            PCISPH meets them where they will be at the end of the step (coupling.predict_solids): "
-                    "rigid ones at their particles' velocity, soft ones at their mean velocity\n");
-        if (rigid && c.two_way && c.strong)
-            std::printf("            rigid ones answer the fluid's pressure inside every PCISPH iteration (coupling.strong)\n");
-        else if (rigid && c.two_way)
-            std::printf("            rigid ones feel the fluid's pressure only after PCISPH (coupling.strong false): it is "
-                        "solved as if they kept their velocity\n");
+                    "rigid ones and cloths at their particles' velocity, soft ones at their mean velocity\n");
+        const bool cloth = std::any_of(scene.objects.begin(), scene.objects.end(),
+                                       [](const SceneObject& o) { return o.kind == SolidKind::kCloth; });
+        const char* answering = rigid && cloth ? "rigid ones and the cloths' nodes" : rigid ? "rigid ones" : "the cloths' nodes";
+        if ((rigid || cloth) && c.two_way && c.strong)
+            std::printf("            %s answer the fluid's pressure inside every PCISPH iteration (coupling.strong)\n",
+                        answering);
+        else if ((rigid || cloth) && c.two_way)
+            std::printf("            %s feel the fluid's pressure only after PCISPH (coupling.strong false): it is "
+                        "solved as if they kept their velocity\n",
+                        answering);
     } else
         std::printf("            PCISPH meets them where they start the step (coupling.predict_solids false): one "
                     "entering the fluid fast can blow it up\n");

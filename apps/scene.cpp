@@ -172,6 +172,11 @@ const ParamTable<SceneObject>& object_keys() {
                                   "inner particles inside the box [min, max] stay at rest").must_be_given());
         t.push_back(vector_key<T>("objects[].pinned.box", "max", member(&T::pin_max), ParamRange::any(), "m",
                                   "its upper corner").must_be_given());
+        t.push_back(vector_key<T>("objects[].pinned.boxes[]", "min", member(&T::pin_min), ParamRange::any(), "m",
+                                  "or several boxes: inner particles inside any of them stay at rest (a cloth's "
+                                  "corners)").must_be_given());
+        t.push_back(vector_key<T>("objects[].pinned.boxes[]", "max", member(&T::pin_max), ParamRange::any(), "m",
+                                  "its upper corner").must_be_given());
         t.push_back(vector_key<T>("objects[].pinned.half_space", "point", member(&T::pin_point), ParamRange::any(), "m",
                                   "inner particles with (x - point).normal < 0 stay at rest (or give box)")
                         .must_be_given());
@@ -196,6 +201,8 @@ std::vector<ParamDoc> keys_read_by_hand() {
 
 // ---- Checks that relate keys ----------------------------------------------------------------
 
+}  // namespace
+
 std::string describe_box(Vec3 lo, Vec3 hi) {
     char buffer[160];  // Real may be float: 6 digits keep 1.6 from printing as 1.600000024
     std::snprintf(buffer, sizeof buffer, "[%.6g, %.6g, %.6g] to [%.6g, %.6g, %.6g]", double(lo.x), double(lo.y),
@@ -208,6 +215,8 @@ std::string describe_point(Vec3 p) {
     std::snprintf(buffer, sizeof buffer, "[%.6g, %.6g, %.6g]", double(p.x), double(p.y), double(p.z));
     return buffer;
 }
+
+namespace {
 
 void check_box(const Section& s, Vec3 lo, Vec3 hi) {
     if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) s.fail(s.key_path("max"), "must exceed min on every axis");
@@ -329,14 +338,26 @@ void read_static_boxes(Section& root, Scene& scene) {
 }
 
 void read_object_pinned(Section s, SceneObject& o) {
-    const bool has_box = s.find("box") != nullptr, has_half = s.find("half_space") != nullptr;
-    if (has_box && has_half) s.fail(s.path(), "give either \"box\" or \"half_space\", not both");
+    const bool has_box = s.find("box") != nullptr, has_boxes = s.find("boxes") != nullptr,
+               has_half = s.find("half_space") != nullptr;
+    if (int(has_box) + int(has_boxes) + int(has_half) > 1)
+        s.fail(s.path(), "give one of \"box\", \"boxes\" or \"half_space\"");
     if (has_box) {
         Section b = s.object("box");
-        o.pin = SceneObject::Pin::kBox;
+        o.pin = SceneObject::Pin::kBoxes;
         b.read(object_keys(), o);
         check_box(b, o.pin_min, o.pin_max);
+        o.pin_boxes.emplace_back(o.pin_min, o.pin_max);
         b.finish();
+    }
+    if (has_boxes) {
+        o.pin = SceneObject::Pin::kBoxes;
+        s.array_of_objects("boxes", [&](Section& b, int) {
+            b.read(object_keys(), o);
+            check_box(b, o.pin_min, o.pin_max);
+            o.pin_boxes.emplace_back(o.pin_min, o.pin_max);
+        });
+        if (o.pin_boxes.empty()) s.fail(s.key_path("boxes"), "must hold at least one box");
     }
     if (has_half) {
         Section h = s.object("half_space");
@@ -364,12 +385,17 @@ void read_object(Section& s, int index, Scene& scene) {
     transform.finish();
     s.read(object_keys(), o);
     s.read(solid_keys(), static_cast<SolidParams&>(o));
-    const char* kind = o.kind == SolidKind::kRigid ? "rigid" : o.kind == SolidKind::kStatic ? "static" : "elastic";
+    const char* kind = o.kind == SolidKind::kRigid    ? "rigid"
+                       : o.kind == SolidKind::kStatic ? "static"
+                       : o.kind == SolidKind::kCloth  ? "cloth"
+                                                      : "elastic";
     if (o.kind == SolidKind::kStatic && o.interface_tension > 0)
-        s.fail(s.key_path("interface_tension"), "is for elastic and rigid objects (this one is static)");
+        s.fail(s.key_path("interface_tension"), "is for elastic, rigid and cloth objects (this one is static)");
     // Melting (docs/melting.md): an elastic object in a scene that conducts heat.
     if (o.melts() && o.kind != SolidKind::kElastic)
         s.fail(s.key_path("melting_point"), std::string("is for elastic objects (this one is ") + kind + ")");
+    if (o.kind == SolidKind::kCloth && scene.params.heat.enabled)
+        s.fail(s.key_path("kind"), "cloth does not conduct heat: set heat.enabled to false, or make it elastic");
     if (o.melts() && !scene.params.heat.enabled)
         s.fail(s.key_path("melting_point"), "needs heat conduction: set heat.enabled to true");
     if (o.latent_heat > 0 && !o.melts()) s.fail(s.key_path("latent_heat"), "needs a melting_point");
@@ -516,7 +542,8 @@ std::vector<ParamDoc> scene_schema() {
     for (const char* section : {"objects[].mesh", "objects[].transform", "objects[]"}) add_rows(rows, object_keys(), section);
     add_rows(rows, solid_keys(), "objects[]");
     add_rows(rows, solid_keys(), "objects[].lsm");
-    for (const char* section : {"objects[].pinned.box", "objects[].pinned.half_space"}) add_rows(rows, object_keys(), section);
+    for (const char* section : {"objects[].pinned.box", "objects[].pinned.boxes[]", "objects[].pinned.half_space"})
+        add_rows(rows, object_keys(), section);
     add_rows(rows, scene_keys(), "run");
     rows.push_back(by_hand[2]);
     add_rows(rows, emitter_keys(), "emitters[]");

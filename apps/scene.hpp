@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -38,8 +39,9 @@ struct SceneObject : SolidParams {
     Vec3 scale{1, 1, 1}, rotation_deg{0, 0, 0}, translation{0, 0, 0};
     Vec3 velocity{0, 0, 0};
     Real temperature = 20;  // C, with heat conduction (fluid.temperature by default)
-    enum class Pin { kNone, kBox, kHalfSpace } pin = Pin::kNone;
-    Vec3 pin_min{}, pin_max{};       // box
+    enum class Pin { kNone, kBoxes, kHalfSpace } pin = Pin::kNone;
+    Vec3 pin_min{}, pin_max{};       // the box being read
+    std::vector<std::pair<Vec3, Vec3>> pin_boxes;  // boxes: IBPs inside any of them are pinned
     Vec3 pin_point{}, pin_normal{};  // half-space: IBPs with (x - point).normal < 0 are pinned
 };
 
@@ -140,5 +142,9 @@ Scene parse_scene_text(const std::string& text, const std::string& source,
 
 // Validates an already-parsed JSON scene (no overrides).
 Scene resolve_scene(const SceneJson& raw, const std::string& source);
+
+// "[x, y, z] to [x, y, z]" and "[x, y, z]", for messages (6 significant digits).
+std::string describe_box(Vec3 lo, Vec3 hi);
+std::string describe_point(Vec3 p);
 
 }  // namespace mw

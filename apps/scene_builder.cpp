@@ -15,6 +15,7 @@
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/signed_distance.hpp"
+#include "sampling/sheet_sample.hpp"
 #include "sampling/solid_sample.hpp"
 #include "sampling/surface_inset.hpp"
 #include "sampling/wall_gap.hpp"
@@ -79,7 +80,26 @@ struct PlacedObject {
     Eigen::AlignedBox3d bounds;
     std::vector<Vec3d> inner;  // IBP positions (inner lattice points for a static object)
     bool moves = false;        // elastic or rigid; static objects never move
+    bool sheet = false;        // a cloth: nothing lies inside it
 };
+
+bool inside_box(Vec3 x, Vec3 lo, Vec3 hi) {
+    return x.x >= lo.x && x.y >= lo.y && x.z >= lo.z && x.x <= hi.x && x.y <= hi.y && x.z <= hi.z;
+}
+
+// A pin that holds none of the object's inner particles (nodes) is a mistake in the scene:
+// refused, naming the box. `inner`: the object's IBPs, at [first, first + inner) of the setup.
+void check_pins_hold(const SceneObject& o, const SimulationSetup& setup, std::size_t first, std::size_t inner) {
+    for (std::size_t b = 0; b < o.pin_boxes.size(); ++b) {
+        const auto& box = o.pin_boxes[b];
+        bool holds = false;
+        for (std::size_t i = first; i < first + inner && !holds; ++i) holds = inside_box(setup.position[i], box.first, box.second);
+        if (!holds)
+            throw InputError("pinned box " + std::to_string(b) + " " + describe_box(box.first, box.second) +
+                             " holds none of the object's inner particles" +
+                             (o.kind == SolidKind::kCloth ? " (the cloth's vertices)" : "") + "; move it onto the object");
+    }
+}
 
 // Solids collide only with the domain walls: two objects, or an object and a static box, that
 // start inside one another stay so, and their boundary particles count twice in the fluid's
@@ -110,6 +130,7 @@ void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& pl
     std::vector<std::vector<long>> inside_count(n, std::vector<long>(n, 0));
     for (std::size_t j = 0; j < n; ++j) {
         const PlacedObject& b = placed[j];
+        if (b.sheet) continue;  // a sheet has no inside
         std::vector<Vec3d> candidates;
         std::vector<std::size_t> owner;  // which object each candidate belongs to
         for (std::size_t k = 0; k < n; ++k) {
@@ -256,10 +277,12 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         static_cast<SolidParams&>(solid) = o;
         solid.name = o.name;
         std::function<bool(const Vec3&)> pinned;
-        if (o.pin == SceneObject::Pin::kBox) {
-            const Vec3 lo = o.pin_min, hi = o.pin_max;
-            pinned = [lo, hi](const Vec3& x) {
-                return x.x >= lo.x && x.y >= lo.y && x.z >= lo.z && x.x <= hi.x && x.y <= hi.y && x.z <= hi.z;
+        if (o.pin == SceneObject::Pin::kBoxes) {
+            const std::vector<std::pair<Vec3, Vec3>> boxes_pinned = o.pin_boxes;
+            pinned = [boxes_pinned](const Vec3& x) {
+                return std::any_of(boxes_pinned.begin(), boxes_pinned.end(), [&](const std::pair<Vec3, Vec3>& b) {
+                    return inside_box(x, b.first, b.second);
+                });
             };
         } else if (o.pin == SceneObject::Pin::kHalfSpace) {
             const Vec3 p = o.pin_point, n = o.pin_normal;
@@ -275,8 +298,13 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             check_object_inside_domain(scene, box);
             check_object_particle_budget(scene, object.mesh, setup.position.size());
             const std::size_t first = setup.position.size();
-            const std::size_t inner = add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
-                                                       scene.params.fluid.support_radius, pinned);
+            const std::size_t inner =
+                o.kind == SolidKind::kCloth
+                    ? add_cloth_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing, pinned)
+                    : add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
+                                       scene.params.fluid.support_radius, pinned);
+            object.sheet = o.kind == SolidKind::kCloth;
+            check_pins_hold(o, setup, first, inner);
             started_at(o.temperature);
             // Fluid moving into a static object is stopped by its signed distance (only where the
             // correction is on and there is fluid to stop).
@@ -471,6 +499,48 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
     }
     setup.solids.push_back(std::move(solid));
     return sample.ibp.count();
+}
+
+std::size_t add_cloth_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
+                             std::int32_t object_id, double r0, const std::function<bool(const Vec3&)>& pinned) {
+    const SheetSample sheet = sample_sheet(mesh, r0);
+    auto to_vec3 = [](const Vec3d& v) { return Vec3{Real(v.x()), Real(v.y()), Real(v.z())}; };
+    auto push = [&](const Vec3& x, std::uint8_t type) {
+        setup.position.push_back(x);
+        setup.velocity.push_back(velocity);
+        setup.type.push_back(type);
+        setup.object.push_back(object_id);
+        return static_cast<std::uint32_t>(setup.position.size() - 1);
+    };
+    solid.spacing = Real(r0);
+    solid.triangles = sheet.mesh.triangles;
+    const std::size_t nodes = sheet.mesh.vertices.size();
+    // One layer of thickness r0: a node weighs its area times density r0 (a flat grid at spacing
+    // r0 has nodes of density r0^3, like a lattice's).
+    for (std::size_t v = 0; v < nodes; ++v) {
+        const Vec3 x = to_vec3(sheet.mesh.vertices[v]);
+        solid.ibp.push_back(push(x, kInnerBoundary));
+        solid.pinned.push_back(pinned && pinned(x) ? 1 : 0);
+        solid.ibp_mass.push_back(Real(double(solid.density) * r0 * sheet.node_area[v]));
+    }
+    solid.ibp_graph_offsets = sheet.graph_offsets;
+    solid.ibp_graph_links = sheet.graph_links;
+    // Each vertex is its own GP: the mesh follows the nodes exactly.
+    solid.gp_offsets.assign(1, 0);
+    for (std::size_t v = 0; v < nodes; ++v) {
+        solid.gp.push_back(push(to_vec3(sheet.mesh.vertices[v]), kGeometry));
+        solid.gp_links.push_back(int(v));
+        solid.gp_weights.push_back(Real(1));
+        solid.gp_offsets.push_back(int(v + 1));
+    }
+    for (std::size_t k = 0; k < sheet.sbp.count(); ++k) {
+        solid.sbp.push_back(push(to_vec3(sheet.sbp.positions[k]), kSurfaceBoundary));
+        solid.sbp_corners.push_back(solid.triangles[std::size_t(sheet.sbp.triangles[k])]);
+        solid.sbp_barycentric.push_back(to_vec3(sheet.sbp.barycentric[k]));
+        solid.sbp_normal.push_back(to_vec3(sheet.sbp.normals[k]));
+    }
+    setup.solids.push_back(std::move(solid));
+    return nodes;
 }
 
 bool add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0, const SealedFace& sealed) {

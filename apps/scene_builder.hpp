@@ -49,6 +49,13 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
                       std::int32_t object_id, double r0, double h,
                       const std::function<bool(const Vec3&)>& pinned = nullptr);
 
+// A cloth (docs/cloth.md): `mesh` (world coordinates), an open sheet, refined to edges of at most 1.5
+// r0 (sampling/sheet_sample.hpp). Each vertex is a shape-matching node (an IBP, with its share of
+// the sheet's area times density r0 as its mass) and a GP; the SBPs are sampled on the triangles.
+// Nodes for which `pinned` is true stay at rest. Returns the number of nodes, appended first.
+std::size_t add_cloth_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
+                             std::int32_t object_id, double r0, const std::function<bool(const Vec3&)>& pinned = nullptr);
+
 // The correction's signed distance grid of a static mesh object (algorithms/wall_contact.hpp),
 // appended to setup.params (static_objects, static_object_distances): at spacing r0/2, reaching
 // the band and two nodes past it outside the mesh's bounding box, at most

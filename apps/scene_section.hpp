@@ -117,7 +117,8 @@ void Section::array_of_objects(const std::string& key, F&& read_element) {
         fail(key_path(key), "at most " + std::to_string(kMaxElements) + " elements, got " + std::to_string(v->size()));
     for (std::size_t i = 0; i < v->size(); ++i) {
         SceneJson element;
-        Section s(&(*v)[i], key_path(key) + "[" + std::to_string(i) + "]", key + "[]", element, source_, resolved_);
+        Section s(&(*v)[i], key_path(key) + "[" + std::to_string(i) + "]", (schema_.empty() ? key : schema_ + "." + key) + "[]",
+                  element, source_, resolved_);
         read_element(s, static_cast<int>(i));
         s.finish();
         out_[key].push_back(element);

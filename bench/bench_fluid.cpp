@@ -32,8 +32,10 @@
 //      without: particles melted, ms per step, and the melting stage's cost on the steps where
 //      something melted (the host's region rebuild) and on the others.
 //  10. The paper's Table 2, the rows the product can run: Fig. 8, a stream poured onto a pinned
-//      elastic bunny (scenes/bunny_stream.json): the particle counts and the stages' medians once
-//      the stream has brought 20,000 fluid particles (the paper's 25k), beside the paper's row.
+//      elastic bunny (scenes/bunny_stream.json), once the stream has brought 20,000 fluid particles
+//      (the paper's 25k), and Fig. 10, a stream poured onto a cloth (scenes/cloth_stream.json),
+//      once it has brought 10,000 (the paper's 15k): the particle counts and the stages' medians,
+//      beside the paper's rows.
 // Prints a Markdown report and, with --out FILE, appends it there, each section as soon as it is
 // measured.
 #include <algorithm>
@@ -301,6 +303,65 @@ std::string format_table(const std::vector<Result>& results) {
         t << cell;
     }
     return t.str();
+}
+
+// One row of the paper's Table 2 (docs/method.md) for a shipped scene with a stream: the particle
+// counts and the stages' medians over the steps once `from_fluid` fluid particles are in, and one
+// mesh of the fluid's surface at each of the scene's frame times (it changes no step), beside the
+// paper's row.
+std::string table2_row(const Options& o, const std::string& label, const std::string& scene_file, double end_time,
+                       long from_fluid, const std::string& paper_row, const std::string& note) {
+    const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/" + scene_file);
+    const SimulationSetup setup = build_setup(scene);
+    std::vector<std::string> names;
+    std::vector<std::vector<double>> stage_ms;
+    std::vector<double> step_ms, surface_ms, field_ms;
+    long fluid = 0, measured = 0, triangles = 0;
+    double next_surface = 0;
+    HostParticles host;
+    FluidSurfacer surfacer(scene.params, scene.surface_voxel, o.threads);
+    const StepObserver stage_times = [&](Simulation& sim, WholeRun&) {
+        fluid = sim.counts().by_type[kFluid];
+        if (fluid < from_fluid) return;
+        if (names.empty()) names = sim.stage_names(), stage_ms.resize(names.size());
+        const StepReport& rep = sim.last_report();
+        for (std::size_t k = 0; k < names.size() && k < rep.stage_ms.size(); ++k) stage_ms[k].push_back(rep.stage_ms[k]);
+        step_ms.push_back(rep.total_ms);
+        ++measured;
+        if (sim.time() + 1e-9 < next_surface) return;
+        next_surface = sim.time() + 1.0 / scene.fps;
+        sim.download(host);  // a frame's download, which the run makes for its frames anyway
+        const FluidSurfacer::Surface surface = surfacer.build(sim, host);
+        triangles = long(surface.mesh.triangles.size());
+        surface_ms.push_back(surface.ms);
+        field_ms.push_back(surface.field_ms);
+    };
+    const WholeRun r = run_whole(o, label, setup, end_time, stage_times);
+    const ParticleCounts counts = count_particles(setup);
+    auto stage = [&](const std::string& name) {
+        for (std::size_t k = 0; k < names.size(); ++k)
+            if (names[k] == name) return median_text(stage_ms[k]);
+        return std::string("-");
+    };
+    std::ostringstream t;
+    t << "### The paper's Table 2: " << label << " (scenes/" << scene_file << " to t = " << end_time
+      << " s; medians over the " << measured << " steps from " << from_fluid << " fluid particles on; " << r.steps
+      << " steps, top speed " << r.top_speed << " m/s, peak density error " << 100 * r.error_max << "%)\n\n"
+      << "| | FP | SBP | IBP | GP | pcisph ms | lsm ms | coupling ms | solid_contact ms | neighbors ms | "
+         "solid_volumes ms | ms/step | surface ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
+      << "| this product, " << o.backend << " | " << fluid << " (at the end) | " << counts.by_type[kSurfaceBoundary]
+      << " | " << counts.by_type[kInnerBoundary] << " | " << counts.by_type[kGeometry] << " | " << stage("pcisph")
+      << " | " << stage("lsm") << " | " << stage("coupling") << " | " << stage("solid_contact") << " | "
+      << stage("neighbors") << " | " << stage("solid_volumes") << " | " << median_text(step_ms) << " | "
+      << median_text(surface_ms) << " (field " << median_text(field_ms) << ") |\n"
+      << paper_row;
+    return t.str() + "\nThe paper's coupling column is its coupling forces and their distribution (this product's "
+                     "`coupling`); where it counts the velocity-position correction (`solid_contact` here) it does not "
+                     "say. " + note + " This product's surface ms is one mesh of the fluid's surface at "
+                     "output.surface.voxel " + format_number(scene.surface_voxel) + " r0 (the colour field and OpenVDB's "
+                     "mesher; the particles' download and the OBJ's writing aside, as in summary.json), median over " +
+           std::to_string(surface_ms.size()) + " meshes at the scene's frame times, the last of " +
+           std::to_string(triangles) + " triangles; the paper's resolution is not given.\n\n";
 }
 
 }  // namespace
@@ -872,74 +933,22 @@ int main(int argc, char** argv) {
                            "fluid particles, 3.6k SBPs, 16.3k IBPs) on a GTX 690, with no separate figure for the phase "
                            "change.\n\n");
         }
-        // The paper's Table 2 (docs/method.md), the rows the product can run. Fig. 8: the stages'
-        // medians over the steps after the stream has brought 20,000 fluid particles.
+        // The paper's Table 2 (docs/method.md), the rows the product can run: the stages' medians
+        // once the stream has brought most of the paper's fluid particles.
         if (o.wants("paper")) {
             const std::string mesh = std::string(MW_SOURCE_DIR) + "/../shared/assets/meshes/stanford-bunny.obj";
             if (!std::ifstream(mesh)) {
-                emit("### The paper's Table 2\n\nSkipped: " + mesh + " is missing (shared/assets).\n\n");
+                emit("### The paper's Table 2: Fig. 8\n\nSkipped: " + mesh + " is missing (shared/assets).\n\n");
             } else {
-                const double end_time = o.quick ? 1.0 : 3.2;
-                const long from_fluid = o.quick ? 0 : 20000;
-                const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/bunny_stream.json");
-                const SimulationSetup setup = build_setup(scene);
-                std::vector<std::string> names;
-                std::vector<std::vector<double>> stage_ms;
-                std::vector<double> step_ms;
-                long fluid = 0, measured = 0;
-                // The surface as a run writing output.formats "surface" meshes it, at the scene's
-                // frame times over the same steps (it changes none of them): all of it, and the
-                // colour field's part (grid build, field, host copy).
-                std::vector<double> surface_ms, field_ms;
-                long triangles = 0;
-                double next_surface = 0;
-                HostParticles host;
-                FluidSurfacer surfacer(scene.params, scene.surface_voxel, o.threads);
-                const StepObserver stage_times = [&](Simulation& sim, WholeRun&) {
-                    fluid = sim.counts().by_type[kFluid];
-                    if (fluid < from_fluid) return;
-                    if (names.empty()) names = sim.stage_names(), stage_ms.resize(names.size());
-                    const StepReport& rep = sim.last_report();
-                    for (std::size_t k = 0; k < names.size() && k < rep.stage_ms.size(); ++k)
-                        stage_ms[k].push_back(rep.stage_ms[k]);
-                    step_ms.push_back(rep.total_ms);
-                    ++measured;
-                    if (sim.time() + 1e-9 < next_surface) return;
-                    next_surface = sim.time() + 1.0 / scene.fps;
-                    sim.download(host);  // a frame's download, which the run makes for its frames anyway
-                    const FluidSurfacer::Surface surface = surfacer.build(sim, host);
-                    triangles = long(surface.mesh.triangles.size());
-                    surface_ms.push_back(surface.ms);
-                    field_ms.push_back(surface.field_ms);
-                };
-                const WholeRun r = run_whole(o, "Fig. 8: stream onto a pinned elastic bunny", setup, end_time, stage_times);
-                const ParticleCounts counts = count_particles(setup);
-                auto stage = [&](const std::string& name) {
-                    for (std::size_t k = 0; k < names.size(); ++k)
-                        if (names[k] == name) return median_text(stage_ms[k]);
-                    return std::string("-");
-                };
-                std::ostringstream t;
-                t << "### The paper's Table 2: Fig. 8 (scenes/bunny_stream.json to t = " << end_time << " s; medians over the "
-                  << measured << " steps from " << from_fluid << " fluid particles on; " << r.steps << " steps, top speed "
-                  << r.top_speed << " m/s, peak density error " << 100 * r.error_max << "%)\n\n"
-                  << "| | FP | SBP | IBP | GP | pcisph ms | lsm ms | coupling ms | solid_contact ms | neighbors ms | "
-                     "solid_volumes ms | ms/step | surface ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
-                  << "| this product, " << o.backend << " | " << fluid << " (at the end) | " << counts.by_type[kSurfaceBoundary]
-                  << " | " << counts.by_type[kInnerBoundary] << " | " << counts.by_type[kGeometry] << " | " << stage("pcisph")
-                  << " | " << stage("lsm") << " | " << stage("coupling") << " | " << stage("solid_contact") << " | "
-                  << stage("neighbors") << " | " << stage("solid_volumes") << " | " << median_text(step_ms)
-                  << " | " << median_text(surface_ms) << " (field " << median_text(field_ms) << ") |\n"
-                  << "| the paper (GTX 690) | 25k | 3.5k | 6k | | 17.3 | 10.1 | 5.3 | | | | 48.1 (with surface) | 15.4 |\n";
-                emit(t.str() + "\nThe paper's coupling column is its coupling forces and their distribution (this "
-                               "product's `coupling`); where it counts the velocity-position correction (`solid_contact` "
-                               "here) it does not say. Its bunny's GPs are not given. This product's surface ms is "
-                               "one mesh of the fluid's surface at output.surface.voxel "
-                            + format_number(scene.surface_voxel) + " r0 (the colour field and OpenVDB's mesher; the "
-                               "particles' download and the OBJ's writing aside, as in summary.json), median over " + std::to_string(surface_ms.size()) +
-                               " meshes at the scene's frame times, the last of " + std::to_string(triangles) +
-                               " triangles; the paper's resolution is not given.\n\n");
+                emit(table2_row(o, "Fig. 8: stream onto a pinned elastic bunny", "bunny_stream.json", o.quick ? 1.0 : 3.2,
+                                o.quick ? 0 : 20000,
+                                "| the paper (GTX 690) | 25k | 3.5k | 6k | | 17.3 | 10.1 | 5.3 | | | | 48.1 (with surface) | 15.4 |\n",
+                                "Its bunny's GPs are not given."));
             }
+            emit(table2_row(o, "Fig. 10: stream onto a cloth", "cloth_stream.json", o.quick ? 0.5 : 1.9, o.quick ? 0 : 10000,
+                            "| the paper (GTX 690) | 15k | 2.5k | – | | 12.5 | 7.0 | 6.2 | | | | 38.1 (with surface) | 12.4 |\n",
+                            "The paper's cloth is 300 kg/m3, this one 1000 kg/m3 (docs/cloth.md); its nodes are the "
+                            "IBP column, and the paper's cloth has its vertices as SBPs only."));
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_fluid: %s\n", e.what());

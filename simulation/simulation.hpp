@@ -52,6 +52,10 @@ struct SolidSetup : SolidParams {
     std::vector<std::uint32_t> ibp;
     std::vector<std::array<int, 3>> lattice;
     std::vector<std::uint8_t> pinned;
+    // Each IBP's mass (empty: density r0^3, a lattice cell's), and the graph its regions grow on
+    // when it has no lattice (cloth: the mesh's edges; CSR over indices into `ibp`).
+    std::vector<Real> ibp_mass;
+    std::vector<std::uint32_t> ibp_graph_offsets, ibp_graph_links;
     // GPs (the vertices of the sampler's mesh: the mesh's own, in order, then the midpoints its
     // refinement added, sampling/mesh_refinement.hpp): index in the setup's lists; CSR links to IBPs (indices
     // into `ibp`) with kernel weights W(x0_g - x0_d) (Eq. 19 normalises them).

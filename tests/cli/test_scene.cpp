@@ -226,7 +226,7 @@ TEST_CASE("bad scenes give one line naming the key") {
          {"objects[0].lsm.body_damping", "-1"}},
         {"interface tension on a static object",
          tiny_scene_text(R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "kind": "static", "interface_tension": 0.2}])"),
-         {}, {"objects[0].interface_tension", "elastic and rigid", "static"}},
+         {}, {"objects[0].interface_tension", "elastic, rigid and cloth", "static"}},
         {"a pressure sensor off the walls", tiny_scene_text(R"("pressure_sensors": [{"center": [0.1, 0.05, 0.1]}])"), {},
          {"pressure_sensors[0].center", "face of the domain", "0.05"}},
         {"a pressure sensor past its face", tiny_scene_text(R"("pressure_sensors": [{"center": [0.2, 0.01, 0.1], "size": 0.04}])"),
@@ -238,6 +238,17 @@ TEST_CASE("bad scenes give one line naming the key") {
          {}, {"pressure_sensors[1].name", "two pressure sensors"}},
         {"a pressure sensor's unknown key", tiny_scene_text(R"("pressure_sensors": [{"center": [0.2, 0.05, 0.1], "diameter": 0.01}])"),
          {}, {"pressure_sensors[0].diameter", "unknown key"}},
+        {"a cloth with heat conduction",
+         tiny_scene_text(R"("heat": {"enabled": true}, "objects": [{"mesh": {"procedural": "sheet:x=0.1,z=0.1"}, "kind": "cloth"}])"),
+         {}, {"objects[0].kind", "cloth does not conduct heat"}},
+        {"pins given two ways",
+         tiny_scene_text(R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "pinned": {"box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1]}, "boxes": []}}])"),
+         {}, {"objects[0].pinned", "give one of"}},
+        {"no pin boxes", tiny_scene_text(R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "pinned": {"boxes": []}}])"),
+         {}, {"objects[0].pinned.boxes", "at least one box"}},
+        {"a pin box's unknown key",
+         tiny_scene_text(R"("objects": [{"mesh": {"procedural": "sphere:radius=0.03"}, "pinned": {"boxes": [{"min": [0, 0, 0], "max": [0.1, 0.1, 0.1], "size": 1}]}}])"),
+         {}, {"objects[0].pinned.boxes[0].size", "unknown key"}},
     };
     for (const Case& c : cases) {
         CAPTURE(c.what);
