@@ -27,8 +27,7 @@ class SolidCorrection final : public Module {
             throw InputError("simulation setup: the solids' slip factor must be in [0, 1]");
         if (!active_) return;
         const std::size_t moving = state.store.moving_count();
-        band_ = static_cast<Real>((solids.surface_inset() ? kInsetSolidContact : kMovingSolidContact) *
-                                  state.params.fluid.spacing);
+        band_ = static_cast<Real>(moving_solid_contact(solids.surface_inset()) * state.params.fluid.spacing);
         near_solid_.resize(moving);
         if (solids.contact_takes_impulses()) impulse_per_weight_.resize(moving);
     }

@@ -92,6 +92,12 @@ constexpr double kMovingSolidContact = kStaticObjectContact;
 // measured from the face: fluid rests a median 0.34-0.40 r0 off it, where a band of 0.45 r0
 // moves resting fluid every step (docs/coupling.md).
 constexpr double kInsetSolidContact = 0.3;
+// The band against the moving objects' SBPs, in r0: one for the whole scene, the narrower one
+// when any SBP sits inside its face (SimulationSetup::any_sbp_set_in; SolidBodies::surface_inset
+// on the device side), so that `meltwater info` and the correction agree.
+constexpr double moving_solid_contact(bool any_sbp_set_in) {
+    return any_sbp_set_in ? kInsetSolidContact : kMovingSolidContact;
+}
 
 struct WallContact {
     static constexpr Real kFar = std::numeric_limits<Real>::max();

@@ -272,9 +272,9 @@ void print_coupling(const InfoFacts& f) {
                     f.moving_objects);
     const bool rigid = std::any_of(scene.objects.begin(), scene.objects.end(),
                                    [](const SceneObject& o) { return o.kind == SolidKind::kRigid; });
-    // Rigid objects' surface particles set in (sampling/surface_inset.hpp); the correction's band
-    // follows (algorithms/solid_correction.hpp).
-    const bool set_in = rigid && c.surface_inset;
+    // Rigid objects' surface particles set in (sampling/surface_inset.hpp; an open mesh's are not);
+    // the correction's band follows (algorithms/wall_contact.hpp, moving_solid_contact).
+    const bool set_in = f.setup.any_sbp_set_in();
     if (set_in) {
         const FluidParams& fp = scene.params.fluid;
         const double inset = rest_density_wall_gap(fp.spacing, fp.support_radius, fp.spacing / 2, 1, fp.kernel);
@@ -283,12 +283,13 @@ void print_coupling(const InfoFacts& f) {
                     inset / double(fp.spacing));
     }
     else if (rigid)
-        std::printf("            rigid ones' surface particles sit on their faces (coupling.surface_inset false): "
-                    "the fluid rests about one r0 off them\n");
+        std::printf("            rigid ones' surface particles sit on their faces (%s): the fluid rests about one r0 "
+                    "off them\n",
+                    c.surface_inset ? "their meshes are open: no inside to set them into" : "coupling.surface_inset false");
     if (c.correction)
         std::printf("            velocity-position correction against them on (coupling.correction): fluid moving into "
                     "one stops %.2f r0 from its surface%s, slip %g\n",
-                    set_in ? kInsetSolidContact : kMovingSolidContact,
+                    moving_solid_contact(set_in),
                     c.two_way ? " and trades momentum with it" : " and takes its velocity", double(c.slip));
     else
         std::printf("            velocity-position correction against them off (coupling.correction false)\n");

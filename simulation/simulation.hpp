@@ -112,6 +112,15 @@ struct SimulationSetup {
     // Initial temperature of every particle, °C (any consistent unit), with params.heat only:
     // empty otherwise.
     std::vector<Real> temperature;
+
+    // Whether any moving object's SBP sits inside its face (SolidSetup::sbp_inset): the
+    // correction's band is then the narrower one (algorithms/wall_contact.hpp).
+    bool any_sbp_set_in() const {
+        for (const SolidSetup& s : solids)
+            for (Real inset : s.sbp_inset)
+                if (inset > Real(0)) return true;
+        return false;
+    }
 };
 
 // The particle state copied back to the host for output.
