@@ -250,6 +250,24 @@ struct ResponseStep {
     Real dt = 0;
 };
 
+// An expected acceleration `a` bounded by the domain's walls: what spans [lo, hi] and moves at v
+// is not expected to shift by dt (v + dt a) past the box shrunk by `margin` on any axis.
+MW_INLINE Vec3 bounded_by_walls(Vec3 a, Vec3 v, Vec3 lo, Vec3 hi, Real margin, const ResponseStep& step) {
+    const Real lo_room[3] = {step.domain_min.x + margin - lo.x, step.domain_min.y + margin - lo.y,
+                             step.domain_min.z + margin - lo.z};
+    const Real hi_room[3] = {step.domain_max.x - margin - hi.x, step.domain_max.y - margin - hi.y,
+                             step.domain_max.z - margin - hi.z};
+    const Real vv[3] = {v.x, v.y, v.z};
+    Real* g[3] = {&a.x, &a.y, &a.z};
+    const Real inverse_dt2 = Real(1) / (step.dt * step.dt);
+    for (int k = 0; k < 3; ++k) {
+        const Real shift = step.dt * vv[k] + step.dt * step.dt * *g[k];
+        if (shift < lo_room[k]) *g[k] = (lo_room[k] - step.dt * vv[k]) * inverse_dt2;
+        if (shift > hi_room[k]) *g[k] = (hi_room[k] - step.dt * vv[k]) * inverse_dt2;
+    }
+    return a;
+}
+
 // A new try: every object expected to keep its velocity.
 inline void start_object_responses(const DeviceContext& device, std::size_t object_count, ObjectResponse* response,
                                    ResponseRelaxation* relaxation) {
@@ -298,20 +316,7 @@ inline void relax_object_accelerations(const DeviceContext& device, ObjectIbps o
         target.linear = step.gravity + force / body.M;
         target.angular = motion.inverse_inertia * (torque - cross(motion.centre, force));
         // The walls: the object's expected shift dt (V + dt G) keeps its extent inside the box.
-        const Real lo_room[3] = {step.domain_min.x + params.margin - (anchor.x + lo.x),
-                                 step.domain_min.y + params.margin - (anchor.y + lo.y),
-                                 step.domain_min.z + params.margin - (anchor.z + lo.z)};
-        const Real hi_room[3] = {step.domain_max.x - params.margin - (anchor.x + hi.x),
-                                 step.domain_max.y - params.margin - (anchor.y + hi.y),
-                                 step.domain_max.z - params.margin - (anchor.z + hi.z)};
-        const Real v[3] = {motion.velocity.x, motion.velocity.y, motion.velocity.z};
-        Real* g[3] = {&target.linear.x, &target.linear.y, &target.linear.z};
-        const Real inverse_dt2 = Real(1) / (step.dt * step.dt);
-        for (int k = 0; k < 3; ++k) {
-            const Real shift = step.dt * v[k] + step.dt * step.dt * *g[k];
-            if (shift < lo_room[k]) *g[k] = (lo_room[k] - step.dt * v[k]) * inverse_dt2;
-            if (shift > hi_room[k]) *g[k] = (hi_room[k] - step.dt * v[k]) * inverse_dt2;
-        }
+        target.linear = bounded_by_walls(target.linear, motion.velocity, anchor + lo, anchor + hi, params.margin, step);
         // Aitken over (linear, size × angular), one ω per object.
         const Real size = Real(0.5) * norm(hi - lo);
         const Vec3 r_linear = target.linear - now.linear, r_angular = size * (target.angular - now.angular);
@@ -424,15 +429,13 @@ inline void interpolate_node_responses(const DeviceContext& device, const NodeRe
     });
 }
 
-// A new try: every node expected to move as in the last step (`warm`), the SBPs after them.
+// A new try: every node expected to move as in the last step (`warm`), the SBPs after them (each
+// cloth's ω starts again with the rigid objects', start_object_responses).
 inline void start_node_responses(const DeviceContext& device, const NodeResponse n, const Vec3* warm, Vec3* accel) {
     parallel_for(device, "strong_coupling_nodes_start", n.ibp_count, [=] MW_HD(std::size_t s) {
         if (!n.params[n.slot_object[s]].nodal) return;
         accel[s] = n.pinned[s] ? Vec3{0, 0, 0} : warm[s];
         n.last_residual[s] = Vec3{0, 0, 0};
-    });
-    parallel_for(device, "strong_coupling_nodes_start_objects", n.object_count, [=] MW_HD(std::size_t o) {
-        if (n.params[o].nodal) n.relaxation[o] = ResponseRelaxation{};
     });
     interpolate_node_responses(device, n, accel);
 }
@@ -450,19 +453,7 @@ inline void relax_node_accelerations(const DeviceContext& device, const NodeResp
             target = n.other[s] + n.fluid_acceleration[s];
             // The walls: the node's shift dt (v + dt a) stays inside the box shrunk by its margin.
             const std::uint32_t i = n.store_of_slot[s];
-            const Vec3 x = position[i], v = velocity[i];
-            const Real lo[3] = {step.domain_min.x + params.margin - x.x, step.domain_min.y + params.margin - x.y,
-                                step.domain_min.z + params.margin - x.z};
-            const Real hi[3] = {step.domain_max.x - params.margin - x.x, step.domain_max.y - params.margin - x.y,
-                                step.domain_max.z - params.margin - x.z};
-            const Real vv[3] = {v.x, v.y, v.z};
-            Real* g[3] = {&target.x, &target.y, &target.z};
-            const Real inverse_dt2 = Real(1) / (step.dt * step.dt);
-            for (int k = 0; k < 3; ++k) {
-                const Real shift = step.dt * vv[k] + step.dt * step.dt * *g[k];
-                if (shift < lo[k]) *g[k] = (lo[k] - step.dt * vv[k]) * inverse_dt2;
-                if (shift > hi[k]) *g[k] = (hi[k] - step.dt * vv[k]) * inverse_dt2;
-            }
+            target = bounded_by_walls(target, velocity[i], position[i], position[i], params.margin, step);
         }
         n.target_residual[s] = target - accel[s];
     });

@@ -366,6 +366,7 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
             L.sbp.push_back(link);
             L.sbp_normal.push_back(s.sbp_normal[k]);
         }
+        // Flags for every SBP so far once any is two-sided; none stored before that.
         if (s.kind == SolidKind::kCloth) L.sbp_two_sided.resize(first_sbp, 0);
         if (s.kind == SolidKind::kCloth || !L.sbp_two_sided.empty())
             L.sbp_two_sided.resize(L.sbp.size(), s.kind == SolidKind::kCloth ? 1 : 0);

@@ -48,7 +48,7 @@ TEST_CASE("A coarse sheet is refined to nodes about r0 apart, which share its ar
     CHECK(s.boundary_edges == 10);
 }
 
-TEST_CASE("A sheet that is closed, has an edge of three triangles or faces both ways is refused") {
+TEST_CASE("A sheet that is closed, has an edge of three triangles, faces both ways or has a triangle of no area is refused") {
     CHECK(refusal(make_box(Vec3d(0.1, 0.1, 0.1))).find("the mesh is closed") != std::string::npos);
     TriangleMesh fin = make_sheet(0.1, 0.1, 1, 1);  // two triangles, and a third on their diagonal
     fin.vertices.emplace_back(0.0, 0.1, 0.0);
@@ -57,5 +57,10 @@ TEST_CASE("A sheet that is closed, has an edge of three triangles or faces both 
     TriangleMesh flipped = make_sheet(0.1, 0.1, 1, 1);
     std::swap(flipped.triangles[1][0], flipped.triangles[1][1]);
     CHECK(refusal(flipped).find("not consistently oriented") != std::string::npos);
+    TriangleMesh needle = make_sheet(0.1, 0.1, 1, 1);  // a third triangle with its corners on a line
+    needle.vertices.emplace_back(0.2, 0.0, 0.05);
+    needle.vertices.emplace_back(0.3, 0.0, 0.05);
+    needle.triangles.push_back({int(needle.vertices.size() - 2), int(needle.vertices.size() - 1), int(needle.vertices.size() - 1)});
+    CHECK(refusal(needle).find("has no area") != std::string::npos);
     CHECK(refusal(make_sheet(0.1, 0.1, 5, 5)) == "accepted");
 }
