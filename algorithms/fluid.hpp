@@ -63,18 +63,29 @@ class Fluid final : public Module {
     // stalls short of it (most often under a low max_iterations) is solved at a shorter step, not
     // integrated unconverged.
     void solve(StepContext& step) {
+        const auto attempt = [&](Real length) {
+            const Real delta = static_cast<Real>(state_.delta_times_dt2 / (double(length) * double(length)));
+            step.lookahead.dt = length;  // PCISPH meets the moving solids where this try's step takes them
+            int tried = 0;
+            step.neighbors.visit([&](const auto& rows) { iterate(rows, step, delta, length, tried); });
+            step.iterations += tried;
+        };
         Real dt = step.dt;
         for (;;) {
-            const Real delta = static_cast<Real>(state_.delta_times_dt2 / (double(dt) * double(dt)));
-            step.lookahead.dt = dt;  // PCISPH meets the moving solids where this try's step takes them
-            int tried = 0;
-            step.neighbors.visit([&](const auto& rows) { iterate(rows, step, delta, dt, tried); });
-            step.iterations += tried;
+            attempt(dt);
             if (step.outcome == PcisphOutcome::kConverged ||
                 !StepSizeControl::may_retry(state_.params.solver, step.retries, dt))
                 break;
             dt *= Real(0.5);
             ++step.retries;
+        }
+        if (step.outcome == PcisphOutcome::kDiverged && step.retries > 0) {
+            // Every halving diverged as well: the step starts from a state compressed beyond what
+            // a shorter step undoes, and at dt/2^k the pressure that undoes it becomes a velocity
+            // 2^k times larger (a 2 m/s stream meeting a wall: 778 m/s after six halvings). The
+            // step is taken at its first try's length, as fixed mode takes it.
+            dt = step.dt;
+            attempt(dt);
         }
         // After a retry the next steps start from the step that held and grow back gradually.
         step_size_.after_step(step.retries, step.outcome == PcisphOutcome::kConverged, dt);

@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "algorithms/lsm_regions.hpp"
+#include "algorithms/solid_obstacles.hpp"
 #include "algorithms/polar_decomposition.hpp"
 #include "backend/backend.hpp"
 
@@ -93,7 +94,27 @@ struct LsmStepParams {
     Real dt = 0;
     Vec3 gravity{0, 0, 0};
     Vec3 domain_min{0, 0, 0}, domain_max{0, 0, 0};
+    SolidObstacles obstacles;  // static boxes and mesh objects (solid_obstacles.hpp)
 };
+
+// Sweeps of an elastic IBP over its deepest obstacle contact (an IBP in a stair's inner corner
+// meets a tread and a riser).
+constexpr int kObstacleSweeps = 2;
+
+// An elastic IBP (or a cloth node) at the obstacles: out to the margin along the deepest contact's
+// normal, its velocity into the obstacle dropped and a share `friction` of its sliding removed,
+// as at a domain wall.
+MW_INLINE void keep_out_of_obstacles(const SolidObstacles& obstacles, Real margin, Real friction, Vec3& x, Vec3& v) {
+    for (int sweep = 0; sweep < kObstacleSweeps; ++sweep) {
+        Vec3 n{0, 0, 0};
+        Real depth = 0;
+        if (!obstacles.deepest(x, margin, n, depth)) return;
+        x += depth * n;
+        const Real vn = dot(v, n);
+        const Vec3 normal = vn < Real(0) ? Vec3{0, 0, 0} : vn * n;
+        v = normal + (Real(1) - friction) * (v - vn * n);
+    }
+}
 
 // Displacements are taken relative to one member's (the anchor's, the region's first): a
 // translation of the region then gives exactly zero sums, and ū exactly the translation.
@@ -260,6 +281,7 @@ inline void lsm_particle_update(const DeviceContext& device, const LsmData d, co
             d.velocity[i] = v;
             return;
         }
+        if (p.obstacles.any()) keep_out_of_obstacles(p.obstacles, obj.margin, obj.friction, x, v);
         // Domain walls: clamp into the box shrunk by the margin, drop the outward normal velocity,
         // scale the tangential velocity by (1 - friction) on each wall touched.
         const Real lo[3] = {p.domain_min.x + obj.margin, p.domain_min.y + obj.margin, p.domain_min.z + obj.margin};
@@ -345,7 +367,8 @@ MW_INLINE Vec3 axis_vector(int axis, Real length) {
 // Clamped IBP by IBP, a rigid box thrown against the ceiling was squashed against it (the shape
 // matching of the next step fits the squashed shape, which the walls squash again).
 inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const LsmStepParams p,
-                            const std::uint32_t* object_ibp_begin, std::size_t object_count, Vec3* wall_impulse) {
+                            const std::uint32_t* object_ibp_begin, std::size_t object_count, Vec3* wall_impulse,
+                            Real* obstacle_impulse) {
     parallel_for(device, "lsm_rigid_walls", object_count, [=] MW_HD(std::size_t o) {
         const LsmObjectParams obj = d.objects[o];
         if (!obj.rigid) return;
@@ -371,6 +394,9 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
                 if (above > depth[2 * a + 1]) depth[2 * a + 1] = above;
                 touching = touching || below > Real(0) || above > Real(0);
             }
+            Vec3 n{0, 0, 0};
+            Real obstacle_depth = 0;
+            touching = touching || p.obstacles.deepest(x, obj.margin, n, obstacle_depth);
             body.add(d.mass[s], r, d.velocity[i]);
         }
         if (!touching || !(body.M > Real(0)) || !is_finite(body.momentum)) return;  // non-finite values are the guard's
@@ -385,7 +411,10 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
         // r from c along n changes by j (1/M + n · ((I⁻¹ (r × n)) × r)) for an impulse j. A box on
         // a face so rests on the whole face; met at one point a step, the mean of the IBPs past a
         // wall, it rocked about that point.
-        for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) wall_impulse[s] = Vec3{0, 0, 0};
+        for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {
+            wall_impulse[s] = Vec3{0, 0, 0};
+            obstacle_impulse[s] = Real(0);
+        }
         for (int sweep = 0; sweep < kRigidWallSweeps; ++sweep) {
             for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {
                 const std::uint32_t i = d.store_of_slot[s];
@@ -406,6 +435,17 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
                     omega += inverse_inertia * cross(r, (after - before) * n);
                     wall_impulse[s] += axis_vector(a, side * (after - before));
                 }
+                // Its deepest obstacle contact, the same way along that obstacle's normal.
+                Vec3 n{0, 0, 0};
+                Real depth = 0;
+                if (!p.obstacles.deepest(x, obj.margin, n, depth)) continue;
+                const Real k = Real(1) / M + dot(n, cross(inverse_inertia * cross(r, n), r));
+                const Real before = obstacle_impulse[s];
+                const Real vn = dot(V + cross(omega, r), n);
+                const Real after = before - vn / k > Real(0) ? before - vn / k : Real(0);
+                V += ((after - before) / M) * n;
+                omega += inverse_inertia * cross(r, (after - before) * n);
+                obstacle_impulse[s] = after;
             }
         }
         // Friction on the body's sliding, through its centre (it turns nothing), then the body out
@@ -416,6 +456,26 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
             const Vec3 n = axis_vector(f / 2, (f & 1) ? Real(-1) : Real(1));
             if (obj.friction > Real(0)) V -= obj.friction * (V - dot(V, n) * n);
             shift += depth[f] * n;
+        }
+        // The obstacles: friction along the deepest contact's normal, and the body out of every
+        // contact in sweeps (an IBP needs depth along n, less what the shift so far gives).
+        if (p.obstacles.any()) {
+            Real deepest = 0;
+            Vec3 deepest_normal{0, 0, 0};
+            for (int sweep = 0; sweep < kObstacleSweeps; ++sweep) {
+                for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {
+                    const std::uint32_t i = d.store_of_slot[s];
+                    if (i == kMeltedSlot) continue;
+                    Vec3 n{0, 0, 0};
+                    Real depth = 0;
+                    if (!p.obstacles.deepest(d.position[i], obj.margin, n, depth)) continue;
+                    if (sweep == 0 && depth > deepest) deepest = depth, deepest_normal = n;
+                    const Real need = depth - dot(shift, n);
+                    if (need > Real(0)) shift += need * n;
+                }
+            }
+            if (deepest > Real(0) && obj.friction > Real(0))
+                V -= obj.friction * (V - dot(V, deepest_normal) * deepest_normal);
         }
         for (std::uint32_t s = object_ibp_begin[o]; s < object_ibp_begin[o + 1]; ++s) {
             const std::uint32_t i = d.store_of_slot[s];

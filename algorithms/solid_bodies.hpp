@@ -20,6 +20,7 @@
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
 #include "algorithms/pcisph.hpp"
+#include "algorithms/solid_collisions.hpp"
 #include "algorithms/solid_contact.hpp"
 #include "algorithms/solid_interpolation.hpp"
 #include "algorithms/state_archive.hpp"
@@ -116,6 +117,10 @@ class SolidBodies final : public Module {
         }
         body_motion_.assign(body_damping ? L.objects.size() : 0, BodyMotion{});
         wall_impulse_.assign(has_rigid_ ? ibp_count_ : 0, Vec3{0, 0, 0});
+        contact_.init(setup.params, ibp_count_, setup.solids.size(),
+                      std::size_t(std::count_if(setup.solids.begin(), setup.solids.end(),
+                                                [](const SolidSetup& o) { return o.kind != SolidKind::kStatic; })),
+                      has_rigid_);
         gp_rest_.upload(L.gp_rest);
         gp_offsets_.upload(L.gp_offsets);
         gp_links_.upload(L.gp_links);
@@ -265,7 +270,7 @@ class SolidBodies final : public Module {
         if (predicts_)
             plan.bind("solid_volumes", [this](StepContext& step) { step.lookahead = lookahead(*store_, step.ranges.solid_end); });
         plan.bind("lsm", [this](StepContext& step) {
-            step.solid_motion = this->step(*store_, step.dt, gravity_, domain_min_, domain_max_);
+            step.solid_motion = this->step(*store_, step.dt, gravity_, domain_min_, domain_max_, step.neighbors.grid);
         });
     }
     // The summary's reduction makes its workspace on first use: once here, before the first step.
@@ -282,7 +287,8 @@ class SolidBodies final : public Module {
 
     // One LSM step (the slot map must be current): regions and IBP update in substeps
     // (substeps()), whole-body damping, then GPs and SBPs once.
-    SolidSummary step(ParticleStore& store, Real dt, Vec3 gravity, Vec3 domain_min, Vec3 domain_max) {
+    SolidSummary step(ParticleStore& store, Real dt, Vec3 gravity, Vec3 domain_min, Vec3 domain_max,
+                      const GridView& grid = GridView{}) {
         const LsmData d = data(store);
         LsmStepParams p;
         const int n = substeps(dt);
@@ -290,11 +296,17 @@ class SolidBodies final : public Module {
         p.gravity = gravity;
         p.domain_min = domain_min;
         p.domain_max = domain_max;
+        p.obstacles = contact_.obstacles();
         // The fluid's forces (a_ext) hold over the whole step: substeps apply the same impulse.
+        // Each substep's contacts: the walls and static obstacles, then one solid with another.
         for (int k = 0; k < n; ++k) {
             lsm_region_update(device_, d);
             lsm_particle_update(device_, d, p);
-            if (has_rigid_) lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_, wall_impulse_.view().data());
+            if (has_rigid_)
+                lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_, wall_impulse_.view().data(),
+                                contact_.obstacle_impulse());
+            if (contact_.between_solids())
+                solid_collisions(device_, contact_.collisions(d, grid, store, *solid_slot_, object_ibp_begin_.view().data()), p.dt);
         }
         if (body_motion_.size())
             lsm_body_damping(device_, d, dt, object_ibp_begin_.view().data(), object_count_, body_motion_.view().data());
@@ -529,7 +541,7 @@ class SolidBodies final : public Module {
                sbp_.bytes() + sbp_normal_.bytes() + sbp_two_sided_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
                object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes() +
-               body_motion_.bytes();
+               body_motion_.bytes() + contact_.bytes();
     }
 
     LsmData data(ParticleStore& store) {
@@ -669,6 +681,7 @@ class SolidBodies final : public Module {
     Real substep_ = 0;          // solver.solid_substep
     DeviceArray<Vec3> wall_impulse_;  // per IBP of a rigid object, its walls' impulses this step
     DeviceArray<BodyMotion> body_motion_;  // per object, with lsm.body_damping: its rigid motion this step
+    SolidContactState contact_;  // the static obstacles and the contacts between solids
     DeviceArray<std::int32_t>* solid_slot_ = nullptr;  // owned by the store
     DeviceArray<std::uint32_t> store_of_slot_;
     DeviceArray<Vec3> rest_;

@@ -45,6 +45,23 @@
 
 namespace mw {
 
+// For x inside the box [lo, hi]: the face it is nearest to, 2 axis + 1 for the high side, and its
+// distance from it.
+MW_INLINE int nearest_inner_face(Vec3 x, Vec3 lo, Vec3 hi, Real& distance) {
+    const Real depth[6] = {x.x - lo.x, hi.x - x.x, x.y - lo.y, hi.y - x.y, x.z - lo.z, hi.z - x.z};
+    int face = 0;
+    for (int f = 1; f < 6; ++f)
+        if (depth[f] < depth[face]) face = f;
+    distance = depth[face];
+    return face;
+}
+// That face's outward unit normal.
+MW_INLINE Vec3 box_face_normal(int face) {
+    const Real sign = (face & 1) ? Real(1) : Real(-1);
+    const int axis = face >> 1;
+    return Vec3{axis == 0 ? sign : Real(0), axis == 1 ? sign : Real(0), axis == 2 ? sign : Real(0)};
+}
+
 // A static box's faces (its first boundary layer lies on them, sampling/box_particles.hpp), and
 // how far from the box fluid moving into it is stopped.
 struct ContactBox {
@@ -162,15 +179,10 @@ struct WallContact {
         if (!inside) {
             n = (Real(1) / std::sqrt(d2)) * d;
         } else {
-            // The face nearest to x, by axis and side.
-            const Real depth[6] = {x.x - b.lo.x, b.hi.x - x.x, x.y - b.lo.y, b.hi.y - x.y, x.z - b.lo.z, b.hi.z - x.z};
-            int face = 0;
-            for (int f = 1; f < 6; ++f)
-                if (depth[f] < depth[face]) face = f;
-            const Real sign = (face & 1) ? Real(1) : Real(-1);
+            Real inside = 0;
+            const int face = nearest_inner_face(x, b.lo, b.hi, inside);
             const int axis_index = face >> 1;
-            n = Vec3{axis_index == 0 ? sign : Real(0), axis_index == 1 ? sign : Real(0),
-                     axis_index == 2 ? sign : Real(0)};
+            n = box_face_normal(face);
             if (axis_index == 0) surface.x = (face & 1) ? b.hi.x : b.lo.x;
             if (axis_index == 1) surface.y = (face & 1) ? b.hi.y : b.lo.y;
             if (axis_index == 2) surface.z = (face & 1) ? b.hi.z : b.lo.z;

@@ -8,6 +8,7 @@
 #include "apps/run_estimate.hpp"
 #include "apps/scene_builder.hpp"
 #include "apps/speed_limit.hpp"
+#include "algorithms/solid_obstacles.hpp"
 #include "simulation/factory.hpp"
 #include "common/errors.hpp"
 #include "sampling/wall_gap.hpp"
@@ -317,6 +318,16 @@ void print_coupling(const InfoFacts& f) {
 
 // Emitters (algorithms/emitter.hpp): what each releases, and when; pressure sensors; heat
 // conduction (docs/heat.md).
+// What the moving objects meet (docs/contact.md).
+void print_contact(const InfoFacts& f) {
+    if (!f.moving_objects) return;
+    const BoundaryParams& b = f.setup.params.boundary;
+    std::printf("contact     moving objects meet the domain's faces, %zu static box(es), %zu static object(s)%s "
+                "(docs/contact.md)\n",
+                b.static_boxes.size(), b.static_objects.size(),
+                f.moving_objects > 1 ? (" and one another, in " + std::to_string(kCollisionIterations) + " Jacobi sweeps a substep").c_str() : "");
+}
+
 void print_emitters_and_heat(const InfoFacts& f) {
     const Scene& scene = f.scene;
     const FluidParams& fp = scene.params.fluid;
@@ -388,6 +399,7 @@ int command_info(int argc, char** argv) {
     print_fluid_and_run(facts);
     print_boundary(facts);
     print_coupling(facts);
+    print_contact(facts);
     print_emitters_and_heat(facts);
     for (const std::string& warning : facts.warnings) std::printf("warning     %s\n", warning.c_str());
     return 0;

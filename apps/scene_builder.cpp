@@ -306,11 +306,13 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             object.sheet = o.kind == SolidKind::kCloth;
             check_pins_hold(o, setup, first, inner);
             started_at(o.temperature);
-            // Fluid moving into a static object is stopped by its signed distance (only where the
-            // correction is on and there is fluid to stop).
+            // Fluid moving into a static object is stopped by its signed distance (where the
+            // correction is on and there is fluid to stop), and so are moving solids
+            // (solid_obstacles.hpp).
             const bool any_melts = std::any_of(scene.objects.begin(), scene.objects.end(),
                                                [](const SceneObject& other) { return other.melts(); });
-            if (o.kind == SolidKind::kStatic && scene.params.boundary.correction && (scene.has_fluid() || any_melts))
+            const bool stops_fluid = scene.params.boundary.correction && (scene.has_fluid() || any_melts);
+            if (o.kind == SolidKind::kStatic && (stops_fluid || any_moving))
                 add_static_object_distance(setup, object.mesh, scene.params.fluid.spacing, sealed_faces(scene));
             for (std::size_t i = first; check_overlaps && i < first + inner; ++i) {
                 const Vec3 x = setup.position[i];

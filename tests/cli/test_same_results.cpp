@@ -79,21 +79,24 @@ void check_scene(const std::string& name) {
 TEST_CASE("same results: the fluid-only scenes") {
     for (const char* name : {"dam_break", "dam_break_cylinder", "dam_break_paper_kernel", "hydrostatic_column",
                              "splishsplash_block"}) {
-        CAPTURE(name);
+        const std::string scene_name = name;
+        CAPTURE(scene_name);
         check_scene(name);
     }
 }
 
 TEST_CASE("same results: scenes with solids, heat and melting") {
     for (const char* name : {"cantilever", "floating_boxes", "hanging_film", "melting_ice", "thrown_cube", "warm_jelly"}) {
-        CAPTURE(name);
+        const std::string scene_name = name;
+        CAPTURE(scene_name);
         check_scene(name);
     }
 }
 
 TEST_CASE("same results: scenes with the shared meshes") {
     for (const char* name : {"bunny_stream", "elastic_spot_drop", "pinned_bunny"}) {
-        CAPTURE(name);
+        const std::string scene_name = name;
+        CAPTURE(scene_name);
         check_scene(name);
     }
 }
