@@ -71,15 +71,17 @@ class Fluid final : public Module {
             step.iterations += tried;
         };
         Real dt = step.dt;
+        bool every_try_diverged = true;
         for (;;) {
             attempt(dt);
+            every_try_diverged = every_try_diverged && step.outcome == PcisphOutcome::kDiverged;
             if (step.outcome == PcisphOutcome::kConverged ||
                 !StepSizeControl::may_retry(state_.params.solver, step.retries, dt))
                 break;
             dt *= Real(0.5);
             ++step.retries;
         }
-        if (step.outcome == PcisphOutcome::kDiverged && step.retries > 0) {
+        if (every_try_diverged && step.retries > 0) {
             // Every halving diverged as well: the step starts from a state compressed beyond what
             // a shorter step undoes, and at dt/2^k the pressure that undoes it becomes a velocity
             // 2^k times larger (a 2 m/s stream meeting a wall: 778 m/s after six halvings). The

@@ -306,7 +306,7 @@ class SolidBodies final : public Module {
                 lsm_rigid_walls(device_, d, p, object_ibp_begin_.view().data(), object_count_, wall_impulse_.view().data(),
                                 contact_.obstacle_impulse());
             if (contact_.between_solids())
-                solid_collisions(device_, contact_.collisions(d, grid, store, *solid_slot_, object_ibp_begin_.view().data()), p.dt);
+                solid_collisions(device_, contact_.collisions(d, grid, *solid_slot_, object_ibp_begin_.view().data()), p.dt);
         }
         if (body_motion_.size())
             lsm_body_damping(device_, d, dt, object_ibp_begin_.view().data(), object_count_, body_motion_.view().data());

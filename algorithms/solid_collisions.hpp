@@ -43,7 +43,6 @@ struct CollisionBody {
 struct SolidCollisionData {
     LsmData lsm;
     GridView grid;
-    const std::uint8_t* type = nullptr;           // by store index
     const std::int32_t* solid_slot = nullptr;     // by store index
     SolidObstacles obstacles;                     // with the domain walls
     const std::uint32_t* object_ibp_begin = nullptr;
@@ -54,8 +53,8 @@ struct SolidCollisionData {
 };
 
 // The IBP slot of store particle j when it is another moving object's unmelted IBP; -1 otherwise.
+// (A melting object's outer lattice vertices are IBP slots with the SBP type: the slot decides.)
 MW_INLINE std::int32_t other_ibp(const SolidCollisionData& c, std::uint32_t j, std::int32_t object) {
-    if (c.type[j] != kInnerBoundary) return -1;
     const std::int32_t t = c.solid_slot[j];
     if (t < 0 || std::uint32_t(t) >= c.lsm.ibp_count || c.lsm.object[t] == object) return -1;
     return t;
@@ -172,7 +171,9 @@ inline void gather_solid_impulses(const DeviceContext& device, const SolidCollis
             Real gap = 0;
             c.grid.for_each_solid_around_particle(i, [&](std::uint32_t j) {
                 const std::int32_t t = other_ibp(c, j, object);
-                if (t < 0) return;
+                // Both sides of a pair gather it or neither: an IBP counted out of contact at the
+                // solve's start gathers nothing, so its partners leave it out too.
+                if (t < 0 || c.contacts[t] == 0) return;
                 const LsmObjectParams other = c.lsm.objects[c.lsm.object[t]];
                 if (!pair_contact(c, x, own.margin + other.margin, j, n, gap)) return;
                 const Real w = split_inverse_mass(c, s, i, n) + split_inverse_mass(c, std::uint32_t(t), j, n);
@@ -271,7 +272,7 @@ class SolidContactState {
     }
     Real* obstacle_impulse() { return obstacle_impulse_.view().data(); }
     bool between_solids() const { return between_solids_; }
-    SolidCollisionData collisions(const LsmData& d, const GridView& grid, const ParticleStore& store,
+    SolidCollisionData collisions(const LsmData& d, const GridView& grid,
                                   const DeviceArray<std::int32_t>& solid_slot, const std::uint32_t* object_ibp_begin) {
         SolidCollisionData c;
         c.obstacles = obstacles();
@@ -280,7 +281,6 @@ class SolidContactState {
         c.obstacles.wall_hi = wall_hi_;
         c.lsm = d;
         c.grid = grid;
-        c.type = store.type.cview().data();
         c.solid_slot = solid_slot.cview().data();
         c.object_ibp_begin = object_ibp_begin;
         c.object_count = static_cast<std::uint32_t>(object_count_);
