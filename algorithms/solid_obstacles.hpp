@@ -14,7 +14,7 @@
 namespace mw {
 
 // Sweeps of the Jacobi solve between solids a substep (solid_collisions.hpp): a stack of two
-// rigid boxes stands at 32 and tips over within 6 s at 16 (docs/contact.md).
+// rigid boxes stands at 32 and creeps at 16 (docs/contact.md).
 constexpr int kCollisionIterations = 32;
 
 struct SolidObstacles {
