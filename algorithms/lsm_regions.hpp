@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "simulation/simulation.hpp"
+#include "algorithms/solid_face.hpp"
 #include "algorithms/vec3.hpp"
 #include "common/errors.hpp"
 
@@ -51,7 +52,7 @@ struct LsmObjectParams {
     Real friction = 0;      // wall friction
     Real margin = 0;        // IBPs stay this far inside the domain walls
     std::uint8_t rigid = 0; // 1 for a rigid object (one region), 0 for an elastic one
-    // 1 for a cloth: each node answers the fluid's pressure on its own inside PCISPH
+    // 1 for a cloth or a rod: each node answers the fluid's pressure on its own inside PCISPH
     // (coupling.strong; coupling.hpp, relax_node_accelerations), and PCISPH meets each of its
     // particles at its own velocity.
     std::uint8_t nodal = 0;
@@ -59,10 +60,13 @@ struct LsmObjectParams {
 };
 
 struct SbpLink {
-    std::uint32_t corner[3];  // GP indices (0 .. gp_count) of the triangle's corners
+    // GP indices (0 .. gp_count) of the triangle's corners; a rod's SBP lies on the segment of
+    // corners 0 and 1, and repeats corner 1 as corner 2 (is_segment).
+    std::uint32_t corner[3];
     Vec3 bary;
     Real sign;  // +1 or -1: orients the deformed triangle's normal like the sampled one
     Real inset;  // m: the SBP sits this far inside the triangle, along its normal
+    MW_HD bool is_segment() const { return corner[1] == corner[2]; }
 };
 
 struct LsmHostLayout {
@@ -96,9 +100,10 @@ struct LsmHostLayout {
     // SBPs
     std::vector<SbpLink> sbp;
     std::vector<Vec3> sbp_normal;
-    // Per SBP, 1 where the fluid meets it from both sides (cloth): the correction turns its normal
-    // to the side the fluid particle comes from. Empty when no object is two-sided.
-    std::vector<std::uint8_t> sbp_two_sided;
+    // Per SBP, how the fluid meets it (SbpSides, solid_face.hpp): from both sides (cloth) or all
+    // round (rods) the correction turns its normal toward the fluid particle. Empty when every SBP
+    // is one-sided.
+    std::vector<std::uint8_t> sbp_sides;
     std::vector<LsmObjectParams> objects;
 
     std::size_t region_count() const { return region_mass.size(); }
@@ -366,10 +371,10 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
             L.sbp.push_back(link);
             L.sbp_normal.push_back(s.sbp_normal[k]);
         }
-        // Flags for every SBP so far once any is two-sided; none stored before that.
-        if (s.kind == SolidKind::kCloth) L.sbp_two_sided.resize(first_sbp, 0);
-        if (s.kind == SolidKind::kCloth || !L.sbp_two_sided.empty())
-            L.sbp_two_sided.resize(L.sbp.size(), s.kind == SolidKind::kCloth ? 1 : 0);
+        // Flags for every SBP so far once any is not one-sided; none stored before that.
+        const std::uint8_t sides = s.kind == SolidKind::kCloth ? kSbpTwoSided : s.kind == SolidKind::kRod ? kSbpAround : kSbpOneSided;
+        if (sides != kSbpOneSided) L.sbp_sides.resize(first_sbp, kSbpOneSided);
+        if (sides != kSbpOneSided || !L.sbp_sides.empty()) L.sbp_sides.resize(L.sbp.size(), sides);
     }
 }
 
@@ -421,7 +426,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         const SolidSetup& s = setup.solids[o];
         if (s.kind == SolidKind::kStatic) continue;
         if (s.ibp.empty()) throw InputError("solid '" + s.name + "' has no inner particles (IBPs); make it larger or decrease the spacing");
-        const bool graph = s.kind == SolidKind::kCloth;
+        const bool graph = is_thin(s.kind);
         if (!graph && s.lattice.size() != s.ibp.size())
             throw InputError("solid '" + s.name + "': lattice and ibp lists differ in length");
         if (graph && (s.ibp_graph_offsets.size() != s.ibp.size() + 1 || s.ibp_graph_offsets.back() != s.ibp_graph_links.size()))
@@ -439,7 +444,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         P.friction = s.wall_friction;
         P.margin = Real(0.5) * s.spacing;
         P.rigid = s.kind == SolidKind::kRigid ? 1 : 0;
-        P.nodal = s.kind == SolidKind::kCloth ? 1 : 0;
+        P.nodal = is_thin(s.kind) ? 1 : 0;
         const Real mass = s.density * s.spacing * s.spacing * s.spacing;
         const std::size_t base = ibp_base[o];
         for (std::size_t k = 0; k < s.ibp.size(); ++k) {

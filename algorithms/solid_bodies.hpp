@@ -127,7 +127,7 @@ class SolidBodies final : public Module {
         gp_weights_.upload(L.gp_weights);
         sbp_.upload(L.sbp);
         sbp_normal_.upload(L.sbp_normal);
-        sbp_two_sided_.upload(L.sbp_two_sided);
+        sbp_sides_.upload(L.sbp_sides);
         upload_surface_insets(L, setup);
         members_total_ = L.region_offsets.empty() ? 0 : L.region_offsets.back();
         object_count_ = setup.solids.size();
@@ -458,7 +458,7 @@ class SolidBodies final : public Module {
         c.solid_slot = solid_slot_->cview();
         c.sbp_normal = sbp_normal_.view().data();
         c.sbp_inset = sbp_faces().inset;
-        if (!sbp_two_sided_.empty()) c.sbp_two_sided = sbp_two_sided_.view().data();
+        if (!sbp_sides_.empty()) c.sbp_sides = sbp_sides_.view().data();
         c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
         c.sbp_count = static_cast<std::uint32_t>(sbp_count_);
         c.band = band;
@@ -538,7 +538,7 @@ class SolidBodies final : public Module {
                rotation_.bytes() + rotation_matrix_.bytes() + mean_displacement_.bytes() + region_velocity_.bytes() + region_omega_.bytes() +
                region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
-               sbp_.bytes() + sbp_normal_.bytes() + sbp_two_sided_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
+               sbp_.bytes() + sbp_normal_.bytes() + sbp_sides_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
                object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes() +
                body_motion_.bytes() + contact_.bytes();
@@ -709,7 +709,7 @@ class SolidBodies final : public Module {
     DeviceArray<Real> gp_weights_;
     DeviceArray<SbpLink> sbp_;
     DeviceArray<Vec3> sbp_normal_;
-    DeviceArray<std::uint8_t> sbp_two_sided_;  // empty: no two-sided SBP (cloth)
+    DeviceArray<std::uint8_t> sbp_sides_;  // SbpSides; empty: every SBP one-sided (no cloth or rod)
     DeviceArray<Real> sbp_inset_;  // m, by SBP index, this step's (faded); empty: every SBP on its face
     Real inset_fade_ = 0;          // m (interpolate_surface)
     Real largest_inset_ = 0;       // m

@@ -41,4 +41,26 @@ MW_INLINE Real faded_inset(Real inset, Vec3 face, Vec3 normal, Vec3 lo, Vec3 hi,
     return gap > Real(0) ? inset * (gap / fade) : Real(0);
 }
 
+// How the fluid meets an SBP (its normal in the velocity–position correction): from outside the
+// face (volumes); from either side of a sheet (cloth: the normal turns toward the side the fluid
+// particle comes from); from any direction around a line (rods: the SBP's stored vector is the
+// line's tangent, and the normal is the part of x_i - x_s across it).
+enum SbpSides : std::uint8_t { kSbpOneSided = 0, kSbpTwoSided = 1, kSbpAround = 2 };
+
+// The normal SBP s shows a fluid particle that started the step at `from`: `stored` is its
+// normal (its tangent for kSbpAround), `to_fluid` = from - x_s. Zero where it has no direction
+// (a particle on the line itself).
+MW_INLINE Vec3 sbp_normal_toward(Vec3 stored, std::uint8_t sides, Vec3 to_fluid) {
+    if (sides == kSbpTwoSided) return dot(stored, to_fluid) < Real(0) ? Real(-1) * stored : stored;
+    if (sides != kSbpAround) return stored;
+    Vec3 across = to_fluid - dot(to_fluid, stored) * stored;
+    Real length = norm(across);
+    // Off the end of the line, straight along it: the direction to the particle.
+    if (!(length > Real(1e-3) * norm(to_fluid))) {
+        across = to_fluid;
+        length = norm(across);
+    }
+    return length > Real(0) ? (Real(1) / length) * across : Vec3{0, 0, 0};
+}
+
 }  // namespace mw

@@ -9,8 +9,14 @@
 namespace mw {
 
 // Cloth (docs/cloth.md): one layer of particles on an open sheet mesh, shape-matched over the
-// k-rings of its vertices, met by the fluid from both sides.
-enum class SolidKind { kElastic, kRigid, kStatic, kCloth };
+// k-rings of its vertices, met by the fluid from both sides. Rod (docs/rods.md): one line of
+// particles, shape-matched over runs of nodes along it, met by the fluid from every side.
+enum class SolidKind { kElastic, kRigid, kStatic, kCloth, kRod };
+
+// Cloth and rods: shape-matched over a graph of nodes (the mesh's edges, the line's links) rather
+// than a lattice; every node is a particle the fluid meets, and a node answers the fluid's pressure
+// inside the solve under coupling.strong (docs/cloth.md, "Light cloth").
+inline bool is_thin(SolidKind kind) { return kind == SolidKind::kCloth || kind == SolidKind::kRod; }
 
 struct SolidParams {
     SolidKind kind = SolidKind::kElastic;
@@ -39,9 +45,9 @@ inline const ParamTable<SolidParams>& solid_keys() {
         t.push_back(choice_key<T, SolidKind>(
             "objects[]", "kind", member(&T::kind),
             {{"elastic", SolidKind::kElastic}, {"rigid", SolidKind::kRigid}, {"static", SolidKind::kStatic},
-             {"cloth", SolidKind::kCloth}},
-            "elastic (LSM regions), rigid (one region), static (a fixed boundary) or cloth (one layer on an open "
-            "sheet, docs/cloth.md)"));
+             {"cloth", SolidKind::kCloth}, {"rod", SolidKind::kRod}},
+            "elastic (LSM regions), rigid (one region), static (a fixed boundary), cloth (one layer on an open "
+            "sheet, docs/cloth.md) or rod (one line of particles, docs/rods.md)"));
         t.push_back(number_key<T>("objects[]", "density", member(&T::density), ParamRange::positive(), "kg/m3",
                                   "the solid's density"));
         t.push_back(number_key<T>("objects[]", "interface_tension", member(&T::interface_tension),

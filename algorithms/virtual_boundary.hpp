@@ -89,9 +89,10 @@ struct SolidSurface {
     View<const std::int32_t> solid_slot;
     const Vec3* sbp_normal = nullptr;  // by SBP index; null: no correction against solids
     const Real* sbp_inset = nullptr;   // by SBP index (solid_face.hpp); null: on the face
-    // By SBP index, 1 for an SBP the fluid meets from both sides (cloth); null: none is. Its
-    // normal is turned toward the side the fluid particle comes from (`from` of collide).
-    const std::uint8_t* sbp_two_sided = nullptr;
+    // By SBP index, how the fluid meets it (solid_face.hpp, SbpSides: a cloth's from both sides, a
+    // rod's from all round); null: every SBP from outside its face. Its normal turns toward where
+    // the fluid particle comes from (`from` of collide).
+    const std::uint8_t* sbp_sides = nullptr;
     std::uint32_t ibp_count = 0, sbp_count = 0;  // SBP k has solid slot ibp_count + k
     Real band = 0;   // c, m
     Real reach = 0;  // r0, m
@@ -109,9 +110,9 @@ struct SolidSurface {
     // The virtual particle fluid particle i at x faces: a gather over the SBPs around the cell i
     // was sorted into at this step's build (neighbor_grid.hpp), from the store's positions and
     // velocities. A virtual particle whose normals cancel is none. `from`: where i was at the
-    // start of the step, which decides the side of a two-sided SBP it meets. The paper turns a
-    // cloth's normal along x_is = x_i - x_s; a particle that has already crossed the sheet in this
-    // step would then be pushed on through it.
+    // start of the step, which decides the side of a two-sided SBP it meets and the direction
+    // round a rod's. The paper turns a cloth's normal along x_is = x_i - x_s; a particle that has
+    // already crossed the sheet in this step would then be pushed on through it.
     MW_INLINE VirtualBoundary collide(std::uint32_t i, Vec3 x, Vec3 from, View<const Vec3> position,
                                       View<const Vec3> velocity, const Real* sbp_inverse_mass) const {
         VirtualBoundary k;
@@ -130,8 +131,7 @@ struct SolidSurface {
             k.weight += w;
             k.position += w * xs;
             k.velocity += w * velocity[j];
-            const Vec3 n = sbp_normal[s];
-            normal_sum += (sbp_two_sided && sbp_two_sided[s] && dot(n, from - sbp) < Real(0) ? -w : w) * n;
+            normal_sum += w * (sbp_sides ? sbp_normal_toward(sbp_normal[s], sbp_sides[s], from - sbp) : sbp_normal[s]);
             if (sbp_inverse_mass) k.inverse_mass += w * sbp_inverse_mass[s];
         });
         const Real length = norm(normal_sum);

@@ -296,10 +296,12 @@ void print_coupling(const InfoFacts& f) {
         std::printf("            velocity-position correction against them off (coupling.correction false)\n");
     if (c.predict_solids) {
         std::printf("            PCISPH meets them where they will be at the end of the step (coupling.predict_solids): "
-                    "rigid ones and cloths at their particles' velocity, soft ones at their mean velocity\n");
+                    "rigid ones, cloths and rods at their particles' velocity, soft ones at their mean velocity\n");
         const bool cloth = std::any_of(scene.objects.begin(), scene.objects.end(),
-                                       [](const SceneObject& o) { return o.kind == SolidKind::kCloth; });
-        const char* answering = rigid && cloth ? "rigid ones and the cloths' nodes" : rigid ? "rigid ones" : "the cloths' nodes";
+                                       [](const SceneObject& o) { return is_thin(o.kind); });
+        const char* answering = rigid && cloth ? "rigid ones and the cloths' and rods' nodes"
+                                : rigid        ? "rigid ones"
+                                               : "the cloths' and rods' nodes";
         if ((rigid || cloth) && c.two_way && c.strong)
             std::printf("            %s answer the fluid's pressure inside every PCISPH iteration (coupling.strong)\n",
                         answering);

@@ -30,9 +30,11 @@ std::string numbered(const char* prefix, int index, const char* extension) {
     return name;
 }
 
-// An OBJ file, atomically: a comment line, the vertices and the triangles (1-based in the file).
+// An OBJ file, atomically: a comment line, the vertices and the triangles (1-based in the file);
+// with `polyline`, one line element through every vertex in order (a rod: Blender and Houdini
+// read it as a curve's edges).
 void write_obj(const std::string& path, const std::string& comment, const std::vector<std::array<double, 3>>& vertices,
-               const std::vector<std::array<int, 3>>& triangles) {
+               const std::vector<std::array<int, 3>>& triangles, bool polyline = false) {
     write_file_atomically(path, [&](std::ostream& out) {
         out << "# " << comment << "\n";
         char line[128];
@@ -43,6 +45,11 @@ void write_obj(const std::string& path, const std::string& comment, const std::v
         for (const auto& t : triangles) {
             std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
             out << line;
+        }
+        if (polyline) {
+            out << "l";
+            for (std::size_t v = 1; v <= vertices.size(); ++v) out << ' ' << v;
+            out << "\n";
         }
     });
 }
@@ -210,9 +217,11 @@ std::vector<std::array<double, 3>> object_vertices(const SolidSetup& o, const Ho
 
 void FrameWriter::write_objects(int index, const HostParticles& p) const {
     for (const SolidSetup& o : objects_) {
-        if (o.triangles.empty()) continue;  // a static box: no mesh
+        const bool rod = o.kind == SolidKind::kRod;
+        if (o.triangles.empty() && !rod) continue;  // a static box: no mesh
         write_obj(frames_dir_ + "/object_" + o.name + numbered("_", index, ".obj"),
-                  "meltwater object " + o.name + ", frame " + std::to_string(index), object_vertices(o, p), o.triangles);
+                  "meltwater object " + o.name + ", frame " + std::to_string(index), object_vertices(o, p), o.triangles,
+                  rod);
     }
 }
 

@@ -20,6 +20,36 @@ PreviewMesh preview_mesh(const std::vector<std::array<double, 3>>& vertices,
     return m;
 }
 
+// A rod drawn as a tube of radius r0/2 round its line: a hexagonal prism per segment, each ring
+// square to the line there (the mean of its segments' directions).
+PreviewMesh rod_tube(const std::vector<std::array<double, 3>>& line, double radius) {
+    constexpr int kSides = 6;
+    std::vector<std::array<double, 3>> vertices;
+    std::vector<std::array<int, 3>> triangles;
+    const auto at = [&](std::size_t k) { return Vec3d(line[k][0], line[k][1], line[k][2]); };
+    for (std::size_t k = 0; k < line.size(); ++k) {
+        const Vec3d before = k > 0 ? at(k) - at(k - 1) : at(k + 1) - at(k);
+        const Vec3d after = k + 1 < line.size() ? at(k + 1) - at(k) : before;
+        Vec3d t = before.normalized() + after.normalized();
+        if (!(t.norm() > 0)) t = after;
+        t.normalize();
+        const Vec3d u = t.unitOrthogonal(), w = t.cross(u);
+        for (int s = 0; s < kSides; ++s) {
+            const double a = 2 * M_PI * s / kSides;
+            const Vec3d x = at(k) + radius * (std::cos(a) * u + std::sin(a) * w);
+            vertices.push_back({x.x(), x.y(), x.z()});
+        }
+        if (k == 0) continue;
+        const int ring = int(k) * kSides, last = ring - kSides;
+        for (int s = 0; s < kSides; ++s) {
+            const int s1 = (s + 1) % kSides;
+            triangles.push_back({last + s, last + s1, ring + s1});
+            triangles.push_back({last + s, ring + s1, ring + s});
+        }
+    }
+    return solid_preview_mesh(vertices, triangles);
+}
+
 const char* field_title(PreviewField field) {
     switch (field) {
         case PreviewField::kSpeed: return "speed, m/s";
@@ -52,6 +82,10 @@ PreviewMesh surface_preview_mesh(const TriangleMesh& surface) {
 std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& p) {
     std::vector<PreviewMesh> meshes;
     for (const SolidSetup& o : solids) {
+        if (o.kind == SolidKind::kRod && o.gp.size() > 1) {
+            meshes.push_back(rod_tube(object_vertices(o, p), 0.5 * double(o.spacing)));
+            continue;
+        }
         if (o.melts() || o.triangles.empty()) continue;  // melting: its particles show it; a box: no mesh
         meshes.push_back(solid_preview_mesh(object_vertices(o, p), o.triangles));
     }

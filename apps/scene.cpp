@@ -155,7 +155,7 @@ const ParamTable<SceneObject>& object_keys() {
         t.push_back(text_key<T>("objects[].mesh", "file", member(&T::mesh_file),
                                 "an OBJ file, relative to the scene file (the shipped meshes: ../shared/assets/meshes)"));
         t.push_back(text_key<T>("objects[].mesh", "procedural", member(&T::mesh_procedural),
-                                "or a procedural mesh: box:x=,y=,z= or sphere:radius= (docs/sampling.md)"));
+                                "or a procedural mesh: box:x=,y=,z= or sphere:radius= (docs/sampling.md); a rod's line:length= (docs/rods.md)"));
         t.push_back(vector_key<T>("objects[].transform", "scale", member(&T::scale), ParamRange::any(), "",
                                   "applied first; non-zero on every axis"));
         t.push_back(vector_key<T>("objects[].transform", "rotation_deg", member(&T::rotation_deg), ParamRange::any(),
@@ -388,14 +388,15 @@ void read_object(Section& s, int index, Scene& scene) {
     const char* kind = o.kind == SolidKind::kRigid    ? "rigid"
                        : o.kind == SolidKind::kStatic ? "static"
                        : o.kind == SolidKind::kCloth  ? "cloth"
+                       : o.kind == SolidKind::kRod    ? "rod"
                                                       : "elastic";
     if (o.kind == SolidKind::kStatic && o.interface_tension > 0)
         s.fail(s.key_path("interface_tension"), "is for elastic, rigid and cloth objects (this one is static)");
     // Melting (docs/melting.md): an elastic object in a scene that conducts heat.
     if (o.melts() && o.kind != SolidKind::kElastic)
         s.fail(s.key_path("melting_point"), std::string("is for elastic objects (this one is ") + kind + ")");
-    if (o.kind == SolidKind::kCloth && scene.params.heat.enabled)
-        s.fail(s.key_path("kind"), "cloth does not conduct heat: set heat.enabled to false, or make it elastic");
+    if (is_thin(o.kind) && scene.params.heat.enabled)
+        s.fail(s.key_path("kind"), std::string(kind) + " does not conduct heat: set heat.enabled to false, or make it elastic");
     if (o.melts() && !scene.params.heat.enabled)
         s.fail(s.key_path("melting_point"), "needs heat conduction: set heat.enabled to true");
     if (o.latent_heat > 0 && !o.melts()) s.fail(s.key_path("latent_heat"), "needs a melting_point");

@@ -15,6 +15,7 @@
 #include "sampling/obj_loader.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/signed_distance.hpp"
+#include "sampling/rod_sample.hpp"
 #include "sampling/sheet_sample.hpp"
 #include "sampling/solid_sample.hpp"
 #include "sampling/surface_inset.hpp"
@@ -80,7 +81,7 @@ struct PlacedObject {
     Eigen::AlignedBox3d bounds;
     std::vector<Vec3d> inner;  // IBP positions (inner lattice points for a static object)
     bool moves = false;        // elastic or rigid; static objects never move
-    bool sheet = false;        // a cloth: nothing lies inside it
+    bool sheet = false;        // a cloth or a rod: nothing lies inside it
 };
 
 bool inside_box(Vec3 x, Vec3 lo, Vec3 hi) {
@@ -97,7 +98,10 @@ void check_pins_hold(const SceneObject& o, const SimulationSetup& setup, std::si
         if (!holds)
             throw InputError("pinned box " + std::to_string(b) + " " + describe_box(box.first, box.second) +
                              " holds none of the object's inner particles" +
-                             (o.kind == SolidKind::kCloth ? " (the cloth's vertices)" : "") + "; move it onto the object");
+                             (o.kind == SolidKind::kCloth ? " (the cloth's vertices)"
+                              : o.kind == SolidKind::kRod ? " (the rod's nodes)"
+                                                          : "") +
+                             "; move it onto the object");
     }
 }
 
@@ -298,12 +302,16 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
             check_object_inside_domain(scene, box);
             check_object_particle_budget(scene, object.mesh, setup.position.size());
             const std::size_t first = setup.position.size();
+            if (o.kind != SolidKind::kRod && object.mesh.triangles.empty())
+                throw InputError(object.mesh.source + " has no triangles: a line is a rod's centreline (give the object "
+                                 "kind \"rod\")");
+            const double r0 = scene.params.fluid.spacing;
             const std::size_t inner =
-                o.kind == SolidKind::kCloth
-                    ? add_cloth_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing, pinned)
-                    : add_solid_object(setup, object.mesh, solid, o.velocity, id, scene.params.fluid.spacing,
-                                       scene.params.fluid.support_radius, pinned);
-            object.sheet = o.kind == SolidKind::kCloth;
+                o.kind == SolidKind::kCloth ? add_cloth_object(setup, object.mesh, solid, o.velocity, id, r0, pinned)
+                : o.kind == SolidKind::kRod ? add_rod_object(setup, object.mesh, solid, o.velocity, id, r0, pinned)
+                                            : add_solid_object(setup, object.mesh, solid, o.velocity, id, r0,
+                                                               scene.params.fluid.support_radius, pinned);
+            object.sheet = is_thin(o.kind);
             check_pins_hold(o, setup, first, inner);
             started_at(o.temperature);
             // Fluid moving into a static object is stopped by its signed distance (where the
@@ -503,46 +511,101 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
     return sample.ibp.count();
 }
 
+namespace {
+
+// A thin object's particles (cloth, rod), appended to the setup with `velocity`: its nodes
+// (`nodes`, each weighing `mass[v]`, pinned where `pinned` says, linked along the graph for the
+// regions) as IBPs, each node again as its own GP (its mesh or line follows the nodes exactly),
+// then SBPs pushed by the returned function.
+class ThinObjectParticles {
+   public:
+    ThinObjectParticles(SimulationSetup& setup, SolidSetup& solid, Vec3 velocity, std::int32_t object_id)
+        : setup_(setup), solid_(solid), velocity_(velocity), object_id_(object_id) {}
+
+    static Vec3 to_vec3(const Vec3d& v) { return Vec3{Real(v.x()), Real(v.y()), Real(v.z())}; }
+
+    void add_nodes(const std::vector<Vec3d>& nodes, const std::vector<double>& mass,
+                   const std::vector<std::uint32_t>& graph_offsets, const std::vector<std::uint32_t>& graph_links,
+                   const std::function<bool(const Vec3&)>& pinned) {
+        for (std::size_t v = 0; v < nodes.size(); ++v) {
+            const Vec3 x = to_vec3(nodes[v]);
+            solid_.ibp.push_back(push(x, kInnerBoundary));
+            solid_.pinned.push_back(pinned && pinned(x) ? 1 : 0);
+            solid_.ibp_mass.push_back(Real(mass[v]));
+        }
+        solid_.ibp_graph_offsets = graph_offsets;
+        solid_.ibp_graph_links = graph_links;
+        solid_.gp_offsets.assign(1, 0);
+        for (std::size_t v = 0; v < nodes.size(); ++v) {
+            solid_.gp.push_back(push(to_vec3(nodes[v]), kGeometry));
+            solid_.gp_links.push_back(int(v));
+            solid_.gp_weights.push_back(Real(1));
+            solid_.gp_offsets.push_back(int(v + 1));
+        }
+    }
+    // An SBP at x on the "triangle" `corners` (GP indices) with barycentric weights and normal.
+    void add_sbp(const Vec3d& x, const std::array<int, 3>& corners, const Vec3d& barycentric, const Vec3d& normal) {
+        solid_.sbp.push_back(push(to_vec3(x), kSurfaceBoundary));
+        solid_.sbp_corners.push_back(corners);
+        solid_.sbp_barycentric.push_back(to_vec3(barycentric));
+        solid_.sbp_normal.push_back(to_vec3(normal));
+    }
+
+   private:
+    std::uint32_t push(const Vec3& x, std::uint8_t type) {
+        setup_.position.push_back(x);
+        setup_.velocity.push_back(velocity_);
+        setup_.type.push_back(type);
+        setup_.object.push_back(object_id_);
+        return static_cast<std::uint32_t>(setup_.position.size() - 1);
+    }
+
+    SimulationSetup& setup_;
+    SolidSetup& solid_;
+    Vec3 velocity_;
+    std::int32_t object_id_;
+};
+
+}  // namespace
+
 std::size_t add_cloth_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
                              std::int32_t object_id, double r0, const std::function<bool(const Vec3&)>& pinned) {
     const SheetSample sheet = sample_sheet(mesh, r0);
-    auto to_vec3 = [](const Vec3d& v) { return Vec3{Real(v.x()), Real(v.y()), Real(v.z())}; };
-    auto push = [&](const Vec3& x, std::uint8_t type) {
-        setup.position.push_back(x);
-        setup.velocity.push_back(velocity);
-        setup.type.push_back(type);
-        setup.object.push_back(object_id);
-        return static_cast<std::uint32_t>(setup.position.size() - 1);
-    };
     solid.spacing = Real(r0);
     solid.triangles = sheet.mesh.triangles;
-    const std::size_t nodes = sheet.mesh.vertices.size();
     // One layer of thickness r0: a node weighs its area times density r0 (a flat grid at spacing
     // r0 has nodes of density r0^3, like a lattice's).
-    for (std::size_t v = 0; v < nodes; ++v) {
-        const Vec3 x = to_vec3(sheet.mesh.vertices[v]);
-        solid.ibp.push_back(push(x, kInnerBoundary));
-        solid.pinned.push_back(pinned && pinned(x) ? 1 : 0);
-        solid.ibp_mass.push_back(Real(double(solid.density) * r0 * sheet.node_area[v]));
-    }
-    solid.ibp_graph_offsets = sheet.graph_offsets;
-    solid.ibp_graph_links = sheet.graph_links;
-    // Each vertex is its own GP: the mesh follows the nodes exactly.
-    solid.gp_offsets.assign(1, 0);
-    for (std::size_t v = 0; v < nodes; ++v) {
-        solid.gp.push_back(push(to_vec3(sheet.mesh.vertices[v]), kGeometry));
-        solid.gp_links.push_back(int(v));
-        solid.gp_weights.push_back(Real(1));
-        solid.gp_offsets.push_back(int(v + 1));
-    }
-    for (std::size_t k = 0; k < sheet.sbp.count(); ++k) {
-        solid.sbp.push_back(push(to_vec3(sheet.sbp.positions[k]), kSurfaceBoundary));
-        solid.sbp_corners.push_back(solid.triangles[std::size_t(sheet.sbp.triangles[k])]);
-        solid.sbp_barycentric.push_back(to_vec3(sheet.sbp.barycentric[k]));
-        solid.sbp_normal.push_back(to_vec3(sheet.sbp.normals[k]));
+    std::vector<double> mass(sheet.node_area.size());
+    for (std::size_t v = 0; v < mass.size(); ++v) mass[v] = double(solid.density) * r0 * sheet.node_area[v];
+    ThinObjectParticles particles(setup, solid, velocity, object_id);
+    particles.add_nodes(sheet.mesh.vertices, mass, sheet.graph_offsets, sheet.graph_links, pinned);
+    for (std::size_t k = 0; k < sheet.sbp.count(); ++k)
+        particles.add_sbp(sheet.sbp.positions[k], solid.triangles[std::size_t(sheet.sbp.triangles[k])],
+                          sheet.sbp.barycentric[k], sheet.sbp.normals[k]);
+    setup.solids.push_back(std::move(solid));
+    return mass.size();
+}
+
+std::size_t add_rod_object(SimulationSetup& setup, const TriangleMesh& line, SolidSetup solid, Vec3 velocity,
+                           std::int32_t object_id, double r0, const std::function<bool(const Vec3&)>& pinned) {
+    const RodSample rod = sample_rod(line, r0);
+    solid.spacing = Real(r0);
+    // One line of section r0 × r0: a node r0 from its neighbours weighs density r0³, as a
+    // lattice's IBP does.
+    std::vector<double> mass(rod.nodes.size());
+    for (std::size_t v = 0; v < mass.size(); ++v) mass[v] = double(solid.density) * r0 * r0 * rod.node_length[v];
+    ThinObjectParticles particles(setup, solid, velocity, object_id);
+    particles.add_nodes(rod.nodes, mass, rod.graph_offsets, rod.graph_links, pinned);
+    // An SBP on segment (a, b) is a "triangle" (a, b, b) (SbpLink::is_segment); its stored
+    // normal is the segment's tangent (kSbpAround).
+    for (std::size_t k = 0; k < rod.sbp.size(); ++k) {
+        const int a = int(rod.sbp_segment[k]), b = a + 1;
+        const double f = rod.sbp_fraction[k];
+        particles.add_sbp(rod.sbp[k], {a, b, b}, Vec3d(1 - f, f, 0),
+                          (rod.nodes[std::size_t(b)] - rod.nodes[std::size_t(a)]).normalized());
     }
     setup.solids.push_back(std::move(solid));
-    return nodes;
+    return mass.size();
 }
 
 bool add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0, const SealedFace& sealed) {

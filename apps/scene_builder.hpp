@@ -56,6 +56,13 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
 std::size_t add_cloth_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
                              std::int32_t object_id, double r0, const std::function<bool(const Vec3&)>& pinned = nullptr);
 
+// A rod (docs/rods.md): `line` (world coordinates), its centreline, resampled at steps of at most r0
+// (sampling/rod_sample.hpp). Each node is a shape-matching node (an IBP, with its share of the
+// length times density r0² as its mass) and a GP; the SBPs lie on the segments between nodes.
+// Nodes for which `pinned` is true stay at rest. Returns the number of nodes, appended first.
+std::size_t add_rod_object(SimulationSetup& setup, const TriangleMesh& line, SolidSetup solid, Vec3 velocity,
+                           std::int32_t object_id, double r0, const std::function<bool(const Vec3&)>& pinned = nullptr);
+
 // The correction's signed distance grid of a static mesh object (algorithms/wall_contact.hpp),
 // appended to setup.params (static_objects, static_object_distances): at spacing r0/2, reaching
 // the band and two nodes past it outside the mesh's bounding box, at most

@@ -221,6 +221,14 @@ TriangleMesh make_stairs(int steps, double width, double depth, double height) {
     return b.mesh;
 }
 
+TriangleMesh make_line(double length) {
+    require(std::isfinite(length) && length > 0, "line", "length must be positive");
+    TriangleMesh m;
+    m.vertices = {Vec3d(-length / 2, 0, 0), Vec3d(length / 2, 0, 0)};
+    m.source = "line";
+    return m;
+}
+
 TriangleMesh make_sheet(double size_x, double size_z, int nx, int nz) {
     require(std::isfinite(size_x) && size_x > 0 && std::isfinite(size_z) && size_z > 0, "sheet", "sizes must be positive");
     require(nx >= 1 && nz >= 1, "sheet", "need at least one quad each way");
@@ -245,6 +253,7 @@ const std::map<std::string, std::map<std::string, double>>& procedural_defaults(
         {"cylinder", {{"radius", 0.5}, {"height", 1}, {"segments", 48}}},
         {"stairs", {{"steps", 5}, {"width", 1}, {"depth", 0.2}, {"height", 0.1}}},
         {"sheet", {{"x", 1}, {"z", 1}, {"nx", 16}, {"nz", 16}}},
+        {"line", {{"length", 1}}},
     };
     return d;
 }
@@ -288,7 +297,8 @@ TriangleMesh make_procedural(const std::string& kind, const std::map<std::string
                        as_int(kind, "minor_segments", p["minor_segments"]));
     else if (kind == "cylinder") m = make_cylinder(p["radius"], p["height"], as_int(kind, "segments", p["segments"]));
     else if (kind == "stairs") m = make_stairs(as_int(kind, "steps", p["steps"]), p["width"], p["depth"], p["height"]);
-    else m = make_sheet(p["x"], p["z"], as_int(kind, "nx", p["nx"]), as_int(kind, "nz", p["nz"]));
+    else if (kind == "sheet") m = make_sheet(p["x"], p["z"], as_int(kind, "nx", p["nx"]), as_int(kind, "nz", p["nz"]));
+    else m = make_line(p["length"]);
     std::ostringstream src;
     src << kind;
     for (const auto& kv : params) src << (kv.first == params.begin()->first ? ":" : ",") << kv.first << "=" << kv.second;

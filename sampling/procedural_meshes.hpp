@@ -1,6 +1,6 @@
 // Procedural meshes made by the project. Every maker returns a closed, outward-oriented mesh
 // centred on the origin (bounding-box centre), y up, except make_sheet, which is open (one layer,
-// for cloth). Sizes are in metres. Invalid parameters throw InputError.
+// for cloth), and make_line, which has no triangles (a rod's centreline). Sizes are in metres. Invalid parameters throw InputError.
 #pragma once
 #include <map>
 #include <string>
@@ -24,11 +24,13 @@ TriangleMesh make_cylinder(double radius, double height, int segments = 48);
 TriangleMesh make_stairs(int steps, double width, double depth, double height);
 // Flat open sheet in the xz plane (normal +y), nx × nz quads.
 TriangleMesh make_sheet(double size_x, double size_z, int nx, int nz);
+// A straight line along x through the origin: its two end points, no triangles (a rod's centreline).
+TriangleMesh make_line(double length);
 
 // By name with named parameters, for scenes and the command line:
 //   box: x y z | hollow_box: x y z wall open_top | sphere: radius subdivisions |
 //   torus: major minor major_segments minor_segments | cylinder: radius height segments |
-//   stairs: steps width depth height | sheet: x z nx nz
+//   stairs: steps width depth height | sheet: x z nx nz | line: length
 // A missing parameter takes its default (see procedural_meshes.cpp); an unknown name or
 // parameter throws InputError.
 TriangleMesh make_procedural(const std::string& kind, const std::map<std::string, double>& params);

@@ -146,8 +146,8 @@ TEST_CASE("A cloth's nodes are its sheet's vertices, each weighing its share of 
     for (Real m : cloth.ibp_mass) mass += m;
     CHECK(mass == doctest::Approx(300 * 0.02 * 0.2 * 0.2).epsilon(1e-5));  // density x r0 x area
     const LsmHostLayout L = build_lsm_layout(setup);
-    REQUIRE(L.sbp_two_sided.size() == L.sbp_count);
-    CHECK(std::all_of(L.sbp_two_sided.begin(), L.sbp_two_sided.end(), [](std::uint8_t t) { return t == 1; }));
+    REQUIRE(L.sbp_sides.size() == L.sbp_count);
+    CHECK(std::all_of(L.sbp_sides.begin(), L.sbp_sides.end(), [](std::uint8_t t) { return t == 1; }));
     // Each node's region is the nodes within w = 2 edges; membership is symmetric, so a node's
     // regions are its region's members.
     std::size_t centre = 0, corner = 0;
