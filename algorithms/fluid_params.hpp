@@ -33,6 +33,10 @@ struct SolverParams {
     // a positive value a longer step runs the solids in equal substeps no longer than it, and the
     // sag no longer depends on the step (solid_bodies.hpp, docs/lsm.md).
     Real solid_substep = 0;
+    // Contact between moving solids (solid_collisions.hpp, docs/contact.md): on unless a scene
+    // turns it off. Off, moving solids pass through one another; they still meet the domain's
+    // faces, the static boxes and the static objects.
+    bool solid_contact = true;
 };
 
 // The scenes' peak bound: 5 eta (5% at the default eta of 1%), off when that is 1 or more. On the
@@ -105,6 +109,9 @@ inline const ParamTable<SolverParams>& solver_keys() {
         t.push_back(number_key<T>("solver", "solid_substep", member(&T::solid_substep), ParamRange{0, 1, false, false},
                                   "s", "elastic objects' shape matching runs in substeps no longer than this (a pinned body's sag "
                                   "then does not depend on the step); 0: one per step (docs/lsm.md)"));
+        t.push_back(boolean_key<T>("solver", "solid_contact", member(&T::solid_contact),
+                                   "contact between moving solids (docs/contact.md); false: they pass through one "
+                                   "another, and still meet the domain's faces, static boxes and static objects"));
         return t;
     }();
     return table;

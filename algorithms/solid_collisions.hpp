@@ -257,7 +257,7 @@ class SolidContactState {
         objects_.upload(boundary.static_objects);
         object_distances_.upload(boundary.static_object_distances);
         obstacle_impulse_.assign(has_rigid ? ibp_count : 0, Real(0));
-        between_solids_ = moving_objects > 1;
+        between_solids_ = moving_objects > 1 && params.solver.solid_contact;
         contacts_.assign(between_solids_ ? ibp_count : 0, 0u);
         impulse_.assign(between_solids_ ? ibp_count : 0, Vec3{0, 0, 0});
         body_.assign(between_solids_ ? object_count : 0, CollisionBody{});

@@ -327,7 +327,10 @@ void print_contact(const InfoFacts& f) {
     std::printf("contact     moving objects meet the domain's faces, %zu static box(es), %zu static object(s)%s "
                 "(docs/contact.md)\n",
                 b.static_boxes.size(), b.static_objects.size(),
-                f.moving_objects > 1 ? (" and one another, in " + std::to_string(kCollisionIterations) + " Jacobi sweeps a substep").c_str() : "");
+                f.moving_objects < 2 ? ""
+                : f.setup.params.solver.solid_contact
+                    ? (" and one another, in " + std::to_string(kCollisionIterations) + " Jacobi sweeps a substep").c_str()
+                    : ", not one another (solver.solid_contact false)");
 }
 
 void print_emitters_and_heat(const InfoFacts& f) {

@@ -138,6 +138,18 @@ TEST_CASE("A box dropped onto a static box rests on it, and a second box rests o
     }
 }
 
+TEST_CASE("With solver.solid_contact off, a box dropped onto another passes into it, and still rests on the static box") {
+    const std::unique_ptr<Simulation> sim =
+        create_openmp_simulation(setup_of(on_a_box("rigid", "rigid", true), {"solver.solid_contact=false"}), 1);
+    run_to(*sim, 1.0);
+    HostParticles p;
+    sim->download(p);
+    const std::vector<Vec3> at = centroids(p, 2);
+    MESSAGE("contact off: lower box at y " << at[0].y << ", upper at " << at[1].y);
+    CHECK(at[0].y == doctest::Approx(0.25).epsilon(0.2 * kR0 / 0.25));
+    CHECK(at[1].y == doctest::Approx(0.25).epsilon(0.2 * kR0 / 0.25));  // inside the lower one, on the static box
+}
+
 TEST_CASE("Boxes dropped onto a static stair mesh rest on its steps") {
     // The stair's steps: 0.2 m deep, 0.1 m high, starting at z = 0.1; step k's tread at
     // y = 0.1 (k + 1) for z in 0.1 + 0.2 [k, k + 1].
