@@ -28,9 +28,10 @@ RodSample sample_rod(const TriangleMesh& line, double spacing) {
                          std::to_string(line.triangles.size()) + " triangles");
     const std::vector<Vec3d>& v = line.vertices;
     if (v.size() < 2) throw InputError(src + ": a rod's line needs at least two points");
+    for (std::size_t k = 0; k < v.size(); ++k)
+        if (!v[k].allFinite()) throw InputError(src + ": point " + std::to_string(k + 1) + " is not finite");
     std::vector<double> at(v.size(), 0.0);
     for (std::size_t k = 1; k < v.size(); ++k) {
-        if (!v[k].allFinite()) throw InputError(src + ": point " + std::to_string(k + 1) + " is not finite");
         const double step = (v[k] - v[k - 1]).norm();
         if (!(step > 0)) throw InputError(src + ": points " + std::to_string(k) + " and " + std::to_string(k + 1) + " coincide");
         at[k] = at[k - 1] + step;

@@ -83,7 +83,7 @@ double closest_fluid(const HostParticles& p) {
 
 struct StreamRun {
     double closest = 1e30;  // m, over every step
-    double lowest_tip = 1e30, final_tip = 0;
+    double lowest_tip = 1e30;
     double fastest_fluid = 0;
 };
 
@@ -99,7 +99,6 @@ StreamRun run_stream(double until, const std::vector<std::string>& overrides) {
         r.closest = std::min(r.closest, closest_fluid(p));
         const double tip = double(nodes_of(p).back().y);
         r.lowest_tip = std::min(r.lowest_tip, tip);
-        r.final_tip = tip;
         for (std::size_t i = 0; i < p.type.size(); ++i)
             if (p.type[i] == kFluid) r.fastest_fluid = std::max(r.fastest_fluid, double(norm(p.velocity[i])));
     }

@@ -71,5 +71,8 @@ TEST_CASE("A rod is a line of two or more distinct points, longer than r0 (three
     TriangleMesh one;
     one.vertices = {Vec3d(0, 0, 0)};
     CHECK(refusal(one).find("at least two points") != std::string::npos);
+    TriangleMesh infinite;
+    infinite.vertices = {Vec3d(std::nan(""), 0, 0), Vec3d(0.1, 0, 0)};
+    CHECK(refusal(infinite).find("point 1 is not finite") != std::string::npos);
     CHECK(refusal(make_line(0.1), 0).find("spacing") != std::string::npos);
 }
