@@ -130,7 +130,7 @@ cxxopts::Options render_options() {
         "width", "picture width, pixels (16 to 8192)", cxxopts::value<std::string>(), "W")(
         "height", "picture height, pixels (16 to 8192)", cxxopts::value<std::string>(), "H")(
         "out", "directory for the pictures (default RUN_DIR/frames)", cxxopts::value<std::string>(), "DIR")(
-        "quiet", "print nothing but errors")("h,help", "show this help");
+        "q,quiet", "print nothing but errors")("h,help", "show this help");
     options.parse_positional({"run_dir"});
     options.positional_help("RUN_DIR");
     return options;
@@ -199,7 +199,8 @@ int command_render(int argc, char** argv) {
     const std::map<int, double> times = frame_times(frames_dir);
     const double scale = speed_scale(scene, frame_particles(first_frame));
     // The running count only where a person watches (a terminal), not into a log.
-    const bool counting = !flag_option(args, "quiet") && isatty(fileno(stderr));
+    const bool quiet = flag_option(args, "quiet");
+    const bool counting = !quiet && isatty(fileno(stderr));
     std::string last;
     for (std::size_t k = 0; k < numbers.size(); ++k) {
         const int number = numbers[k];
@@ -215,7 +216,8 @@ int command_render(int argc, char** argv) {
         if (counting) std::fprintf(stderr, "\rmeltwater: rendered %zu of %zu pictures", k + 1, numbers.size());
     }
     if (counting) std::fprintf(stderr, "\n");
-    std::printf("meltwater: %s in %s (the last: %s)\n", count_of(long(numbers.size()), "picture").c_str(),
+    if (!quiet)
+        std::printf("meltwater: %s in %s (the last: %s)\n", count_of(long(numbers.size()), "picture").c_str(),
                 out_dir.c_str(), last.c_str());
     return 0;
 }

@@ -93,6 +93,13 @@ TEST_CASE("render: a finished run's frames drawn again are the pictures the run 
     REQUIRE(pressure.code == 0);
     CHECK(png_size(dir + "/pressure/preview_00002.png") == std::pair<long, long>{200, 100});
     CHECK(!fs::exists(dir + "/pressure/preview_00001.png"));
+    // -q, --quiet: the picture and nothing printed.
+    const Result quiet = run("render " + dir + " --frame 1 -q --out " + dir + "/quiet");
+    CAPTURE(quiet.err);
+    REQUIRE(quiet.code == 0);
+    CHECK(quiet.out.empty());
+    CHECK(quiet.err.empty());
+    CHECK(fs::exists(dir + "/quiet/preview_00001.png"));
 }
 
 TEST_CASE("bad input: preview keys, info's --time-steps, and render's RUN_DIR and options") {
