@@ -1,5 +1,6 @@
 #include "sampling/obj_loader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -100,9 +101,10 @@ std::vector<std::string> tokens_of(const std::string& text, std::size_t from) {
     return tokens;
 }
 
-// Calls visit(line, is_vertex) for every vertex ("v ") and face ("f ") line of the OBJ text.
+// Calls visit(line, kind) for every vertex ("v "), face ("f ") and polyline ("l ") line of the
+// OBJ text, kind its first letter.
 template <class Visit>
-void for_each_vertex_and_face_line(const std::string& text, Visit&& visit) {
+void for_each_element_line(const std::string& text, Visit&& visit) {
     std::size_t pos = 0, line_no = 0;
     while (pos < text.size()) {
         std::size_t end = text.find('\n', pos);
@@ -111,10 +113,37 @@ void for_each_vertex_and_face_line(const std::string& text, Visit&& visit) {
         ++line_no;
         std::size_t p = pos;
         while (p < end && (text[p] == ' ' || text[p] == '\t')) ++p;
-        if (p + 1 < end && (text[p] == 'v' || text[p] == 'f') && (text[p + 1] == ' ' || text[p + 1] == '\t'))
-            visit(ObjLine{line_no, text.substr(p, end - p), unterminated}, text[p] == 'v');
+        if (p + 1 < end && (text[p] == 'v' || text[p] == 'f' || text[p] == 'l') &&
+            (text[p + 1] == ' ' || text[p + 1] == '\t'))
+            visit(ObjLine{line_no, text.substr(p, end - p), unterminated}, text[p]);
         pos = end + 1;
     }
+}
+
+// The vertex index a face corner or a line point refers to ("v", "v/vt", "v//vn" or "v/vt/vn":
+// the vertex index comes first), as written, checked against the `vertices` before it (a
+// negative index counts back from there) and the file's `total_vertices`; `element` ("face 3",
+// "line 1") names it in the message. Read as long long, not int: an index beyond int (which the
+// reader's atoi wraps) saturates and is reported as the number written.
+long long checked_vertex_index(const std::string& corner, const std::string& element, long long vertices,
+                               long long total_vertices, const std::string& source, const ObjLine& line) {
+    const std::string token = corner.substr(0, corner.find('/'));
+    char* after = nullptr;
+    const long long index = std::strtoll(token.c_str(), &after, 10);
+    const bool number = !token.empty() && after != token.c_str() && *after == '\0';
+    if (number && index != 0 && index >= -vertices && index <= total_vertices) return index;
+    std::ostringstream problem;
+    problem << element;
+    if (!number)
+        problem << ": '" << corner << "' is not a vertex index";
+    else if (index == 0)
+        problem << " refers to vertex 0, but OBJ vertex indices start at 1";
+    else if (index < 0)
+        problem << " refers to vertex " << token << " (counted back from the end), but only " << vertices
+                << " vertices precede it";
+    else
+        problem << " refers to vertex " << token << ", but the file has " << total_vertices << " vertices";
+    reject_line(source, line, problem.str());
 }
 
 // tinyobjloader is lenient where a sampler must not be: it reads "nan", "inf" and missing or
@@ -125,21 +154,53 @@ void for_each_vertex_and_face_line(const std::string& text, Visit&& visit) {
 // therefore checked here first, on the text, so each problem is reported with its line number;
 // and the reader is given only what was checked, written afresh: each vertex as "v x y z" with the
 // values already read (printed so that they read back exactly), each face as "f" and its vertex
-// indices. Every other line (normals, texture coordinates, groups, materials, skin weights, ...)
-// the sampler does not use, and the reader never sees.
-std::string checked_obj_text(const std::string& text, const std::string& source) {
+// indices. In a file without faces, polylines ("l", a rod's centreline) are checked the same way
+// and returned in `polylines` (0-based vertex indices), not given to the reader. Every other line (normals, texture
+// coordinates, groups, materials, skin weights, ...) the sampler does not use, and the reader never
+// sees.
+std::string checked_obj_text(const std::string& text, const std::string& source,
+                             std::vector<std::vector<int>>& polylines) {
     // Faces may use vertices defined after them, so positive indices are checked against the
     // file's total, counted first.
-    long long total_vertices = 0;
-    for_each_vertex_and_face_line(text, [&](const ObjLine&, bool is_vertex) { total_vertices += is_vertex; });
+    long long total_vertices = 0, total_faces = 0;
+    for_each_element_line(text, [&](const ObjLine&, char kind) {
+        total_vertices += kind == 'v';
+        total_faces += kind == 'f';
+    });
     const double largest_parsed = double(std::numeric_limits<tinyobj::real_t>::max());
-    long long vertices = 0, faces = 0;
+    long long vertices = 0, faces = 0, lines = 0;
     std::string checked;
     checked.reserve(text.size());
     char number_text[64];
-    for_each_vertex_and_face_line(text, [&](const ObjLine& line, bool is_vertex) {
+    for_each_element_line(text, [&](const ObjLine& line, char kind) {
         const std::vector<std::string> tokens = tokens_of(line.text, 2);
-        if (is_vertex) {
+        if (kind == 'l') {
+            // A surface's stray edges (a file with faces) are not read, as before there were rods.
+            if (total_faces > 0) return;
+            ++lines;
+            if (tokens.size() < 2) {
+                std::ostringstream problem;
+                problem << "line " << lines << " has " << tokens.size() << " point" << (tokens.size() == 1 ? "" : "s")
+                        << ", a line needs at least 2";
+                reject_line(source, line, problem.str());
+            }
+            std::vector<int> points;
+            for (const std::string& point : tokens) {
+                const long long index =
+                    checked_vertex_index(point, "line " + std::to_string(lines), vertices, total_vertices, source, line);
+                const int at = int(index > 0 ? index - 1 : vertices + index);
+                if (std::find(points.begin(), points.end(), at) != points.end()) {
+                    std::ostringstream problem;
+                    problem << "line " << lines << " visits vertex " << at + 1
+                            << " twice; a rod's line is open and does not cross itself";
+                    reject_line(source, line, problem.str());
+                }
+                points.push_back(at);
+            }
+            polylines.push_back(std::move(points));
+            return;
+        }
+        if (kind == 'v') {
             ++vertices;
             if (tokens.size() < 3) {
                 std::ostringstream problem;
@@ -182,31 +243,9 @@ std::string checked_obj_text(const std::string& text, const std::string& source)
             reject_line(source, line, problem.str());
         }
         checked += 'f';
-        for (const std::string& corner : tokens) {
-            // "v", "v/vt", "v//vn" or "v/vt/vn": the vertex index comes first.
-            const std::string token = corner.substr(0, corner.find('/'));
-            // Read as long long, not int: an index beyond int (which the reader's atoi wraps)
-            // saturates and is reported as the number written.
-            char* after = nullptr;
-            const long long index = std::strtoll(token.c_str(), &after, 10);
-            const bool number = !token.empty() && after != token.c_str() && *after == '\0';
-            if (number && index != 0 && index >= -vertices && index <= total_vertices) {
-                checked += ' ' + std::to_string(index);
-                continue;
-            }
-            std::ostringstream problem;
-            problem << "face " << faces;
-            if (!number)
-                problem << ": '" << corner << "' is not a vertex index";
-            else if (index == 0)
-                problem << " refers to vertex 0, but OBJ vertex indices start at 1";
-            else if (index < 0)
-                problem << " refers to vertex " << token << " (counted back from the end), but only " << vertices
-                        << " vertices precede it";
-            else
-                problem << " refers to vertex " << token << ", but the file has " << total_vertices << " vertices";
-            reject_line(source, line, problem.str());
-        }
+        for (const std::string& corner : tokens)
+            checked += ' ' + std::to_string(checked_vertex_index(corner, "face " + std::to_string(faces), vertices,
+                                                                 total_vertices, source, line));
         checked += '\n';
     });
     return checked;
@@ -217,6 +256,36 @@ tinyobj::ObjReaderConfig config() {
     c.triangulate = true;
     c.vertex_color = false;
     return c;
+}
+
+// A rod's centreline from an OBJ with one polyline ("l") and no faces: its points, in the
+// line's order, as a mesh of vertices and no triangles (as the procedural "line" is). `checked`
+// is checked_obj_text's output (the vertices as "v x y z" lines).
+TriangleMesh polyline_mesh(const std::string& checked, const std::string& source,
+                           const std::vector<std::vector<int>>& polylines) {
+    std::vector<Vec3d> vertices;
+    std::istringstream lines(checked);
+    for (std::string line; std::getline(lines, line);) {
+        if (line.rfind("v ", 0) != 0) continue;
+        std::istringstream values(line.substr(2));
+        Vec3d v;
+        values >> v.x() >> v.y() >> v.z();
+        vertices.push_back(v);
+    }
+    if (polylines.size() > 1)
+        throw InputError(source + ": the OBJ holds " + std::to_string(polylines.size()) +
+                         " lines (\"l\"); a rod is one line: join them into one");
+    TriangleMesh mesh;
+    mesh.source = source;
+    for (int k : polylines.front()) mesh.vertices.push_back(vertices[std::size_t(k)]);
+    for (std::size_t k = 0; k < mesh.vertices.size(); ++k)
+        if (mesh.vertices[k].cwiseAbs().maxCoeff() > kMaxCoordinate) {
+            std::ostringstream msg;
+            msg << source << ": point " << k + 1 << " of the line is out of range: coordinates must lie within +-"
+                << kMaxCoordinate;
+            throw InputError(msg.str());
+        }
+    return mesh;
 }
 
 }  // namespace
@@ -234,7 +303,9 @@ TriangleMesh load_obj(const std::string& path, bool require_volume) {
 }
 
 TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume) {
-    const std::string checked = checked_obj_text(text, source);
+    std::vector<std::vector<int>> polylines;
+    const std::string checked = checked_obj_text(text, source, polylines);
+    if (!polylines.empty()) return polyline_mesh(checked, source, polylines);
     tinyobj::ObjReader reader;
     reader.ParseFromString(checked, std::string(), config());
     return from_reader(reader, source, require_volume);

@@ -1,5 +1,7 @@
 // Wavefront OBJ input through tinyobjloader (polygons are triangulated; all shapes are merged
-// into one mesh; normals, texture coordinates and materials are ignored).
+// into one mesh; normals, texture coordinates and materials are ignored). An OBJ of one polyline
+// ("l") and no faces is a rod's centreline: its points in the line's order, no triangles. In a
+// file with faces, lines are not read.
 #pragma once
 #include <string>
 
@@ -10,7 +12,8 @@ namespace mw {
 // missing or unreadable file, parse error, no triangles, a vertex line with fewer than 3
 // coordinates or one that is not a finite number, a face with fewer than 3 corners or an index
 // that is 0, not a number or past the vertices (these name the vertex or face and the line), a
-// coordinate out of range, no volume.
+// coordinate out of range, no volume; for a polyline, a line of fewer than 2 points, an index as
+// for a face, a vertex visited twice, or more than one line.
 TriangleMesh load_obj(const std::string& path, bool require_volume = true);
 // The same from OBJ text (source names it in messages); used by tests.
 TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume = true);

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 #include "common/errors.hpp"
 #include "simulation/factory.hpp"
 #include "test_setups.hpp"
+#include "../scratch_dir.hpp"
 #include "../skip.hpp"
 
 using namespace mw;
@@ -186,6 +189,40 @@ TEST_CASE("Water falling on a rod at 4 m/s parts round it, and bends it down") {
     const StreamRun bare = run_stream(1.0, without);
     MESSAGE("without the correction: closest water " << bare.closest / 0.02 << " r0");
     CHECK(bare.closest < 0.3 * 0.02);
+}
+
+TEST_CASE("A rod's centreline can be an OBJ polyline: a hook, resampled along its bend") {
+    // An L of 0.2 m down and 0.1 m across, as an OBJ line, scaled by the scene's transform.
+    const std::filesystem::path obj = mw_test::scratch_dir("meltwater_core_test") / "hook.obj";
+    {
+        std::ofstream out(obj);
+        out << "v 0 0.1 0\nv 0 -0.1 0\nv 0.1 -0.1 0\nl 1 2 3\n";
+    }
+    const SimulationSetup setup = setup_of(R"({
+  "domain": { "min": [0, 0, 0], "max": [0.5, 0.5, 0.5] },
+  "fluid": { "spacing": 0.02 },
+  "objects": [ { "name": "hook", "mesh": { "file": ")" + obj.string() + R"(" },
+    "transform": { "scale": [1, 1, 1], "translation": [0.2, 0.25, 0.25] }, "kind": "rod", "density": 2000 } ]
+})");
+    REQUIRE(setup.solids.size() == 1);
+    const SolidSetup& rod = setup.solids[0];
+    CHECK(rod.ibp.size() == 16);  // 0.3 m in 15 steps of 0.02 m
+    const Vec3 first = setup.position[rod.ibp.front()], last = setup.position[rod.ibp.back()];
+    CHECK(double(norm(first - Vec3{0.2f, 0.35f, 0.25f})) < 1e-6);
+    CHECK(double(norm(last - Vec3{0.3f, 0.15f, 0.25f})) < 1e-6);
+    double mass = 0;
+    for (Real m : rod.ibp_mass) mass += m;
+    CHECK(mass == doctest::Approx(2000 * 0.02 * 0.02 * 0.3).epsilon(1e-5));
+    // The same file as an elastic object: a line is a rod's.
+    std::string elastic;
+    try {
+        setup_of(R"({ "domain": { "min": [0, 0, 0], "max": [0.5, 0.5, 0.5] }, "fluid": { "spacing": 0.02 },
+  "objects": [ { "name": "hook", "mesh": { "file": ")" + obj.string() + R"(" },
+    "transform": { "translation": [0.2, 0.25, 0.25] }, "kind": "elastic" } ] })");
+    } catch (const InputError& e) {
+        elastic = e.what();
+    }
+    CHECK(elastic.find("give the object kind \"rod\"") != std::string::npos);
 }
 
 TEST_CASE("A rod needs a line of three nodes or more, and a line is only a rod's") {
