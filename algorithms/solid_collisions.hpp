@@ -111,7 +111,9 @@ MW_INLINE Vec3 contact_impulse(Vec3 u, Vec3 n, Real gap, Real w, Real friction, 
     return ((-allowed - un) / w) * n - (friction / w) * (u - un * n);
 }
 
-inline void count_solid_contacts(const DeviceContext& device, const SolidCollisionData c) {
+// Each IBP's contacts (c.contacts) and each rigid object's body; returns how many contacts there
+// are in all (one reduction read back: with none, the sweeps are skipped).
+inline std::uint64_t count_solid_contacts(const DeviceContext& device, const SolidCollisionData c) {
     parallel_for(device, "solid_contact_count", c.lsm.ibp_count, [=] MW_HD(std::size_t si) {
         const std::uint32_t s = static_cast<std::uint32_t>(si);
         const std::uint32_t i = c.lsm.store_of_slot[s];
@@ -130,6 +132,10 @@ inline void count_solid_contacts(const DeviceContext& device, const SolidCollisi
         }
         c.contacts[s] = count;
     });
+    const std::uint32_t* contacts = c.contacts;
+    const std::uint64_t total = transform_reduce(device, "solid_contact_total", c.lsm.ibp_count, std::uint64_t(0), SumOp{},
+                                                 [=] MW_HD(std::size_t s) { return std::uint64_t(contacts[s]); });
+    if (total == 0) return 0;
     // Each rigid object's body (one thread per object, its IBPs in slot order: deterministic).
     parallel_for(device, "solid_contact_bodies", c.object_count, [=] MW_HD(std::size_t o) {
         CollisionBody b;
@@ -154,6 +160,7 @@ inline void count_solid_contacts(const DeviceContext& device, const SolidCollisi
         }
         c.body[o] = b;
     });
+    return total;
 }
 
 // One sweep: every IBP in contact gathers its contacts' impulses (`positions`: the
@@ -226,9 +233,11 @@ inline void apply_solid_impulses(const DeviceContext& device, const SolidCollisi
     });
 }
 
-// The whole contact stage of one substep of length dt.
+// The whole contact stage of one substep of length dt. Without a contact the sweeps would change
+// nothing (every IBP and body skips itself), and their 66 launches cost more than the count's
+// read back: skipped.
 inline void solid_collisions(const DeviceContext& device, const SolidCollisionData c, Real dt) {
-    count_solid_contacts(device, c);
+    if (count_solid_contacts(device, c) == 0) return;
     for (int sweep = 0; sweep < kCollisionIterations; ++sweep) {
         gather_solid_impulses(device, c, dt, false);
         apply_solid_impulses(device, c, dt, false);
