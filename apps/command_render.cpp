@@ -87,8 +87,9 @@ HostParticles frame_particles(const std::string& path) {
     return p;
 }
 
-// The meshes written with frame `number`: each object's, then the fluid's surface.
-std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number) {
+// The meshes written with frame `number`: each object's, then the fluid's surface. A rod's OBJ is
+// its line (one "l", no faces), drawn as the run's preview draws it: a tube of radius r0/2.
+std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number, double spacing) {
     std::vector<PreviewMesh> meshes;
     std::vector<std::string> objects;
     for (const auto& entry : fs::directory_iterator(frames_dir)) {
@@ -103,7 +104,10 @@ std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number)
     };
     for (const std::string& name : objects) {
         const TriangleMesh m = load_obj(frames_dir + "/" + name, false);
-        meshes.push_back(solid_preview_mesh(vertices_of(m), m.triangles));
+        if (m.triangles.empty() && m.vertices.size() > 1)
+            meshes.push_back(rod_tube(vertices_of(m), 0.5 * spacing));
+        else
+            meshes.push_back(solid_preview_mesh(vertices_of(m), m.triangles));
     }
     char surface[40];
     std::snprintf(surface, sizeof surface, "/surface_%05d.obj", number);
@@ -208,7 +212,7 @@ int command_render(int argc, char** argv) {
         std::snprintf(name, sizeof name, "/particles_%05d.vtu", number);
         const HostParticles particles = frame_particles(frames_dir + name);
         const double time = times.count(number) ? times.at(number) : number / scene.fps;
-        const Image picture = preview_picture(scene, particles, frame_meshes(frames_dir, number), time, number, scale);
+        const Image picture = preview_picture(scene, particles, frame_meshes(frames_dir, number, double(scene.params.fluid.spacing)), time, number, scale);
         std::snprintf(name, sizeof name, "/preview_%05d.png", number);
         last = out_dir + name;
         const std::string png = encode_png(picture);

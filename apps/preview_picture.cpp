@@ -20,8 +20,17 @@ PreviewMesh preview_mesh(const std::vector<std::array<double, 3>>& vertices,
     return m;
 }
 
-// A rod drawn as a tube of radius r0/2 round its line: a hexagonal prism per segment, each ring
-// square to the line there (the mean of its segments' directions).
+const char* field_title(PreviewField field) {
+    switch (field) {
+        case PreviewField::kSpeed: return "speed, m/s";
+        case PreviewField::kPressure: return "pressure, Pa";
+        case PreviewField::kDensity: return "density, kg/m3";
+        case PreviewField::kTemperature: return "temperature, C";
+    }
+    return "";
+}
+}  // namespace
+
 PreviewMesh rod_tube(const std::vector<std::array<double, 3>>& line, double radius) {
     constexpr int kSides = 6;
     std::vector<std::array<double, 3>> vertices;
@@ -49,17 +58,6 @@ PreviewMesh rod_tube(const std::vector<std::array<double, 3>>& line, double radi
     }
     return solid_preview_mesh(vertices, triangles);
 }
-
-const char* field_title(PreviewField field) {
-    switch (field) {
-        case PreviewField::kSpeed: return "speed, m/s";
-        case PreviewField::kPressure: return "pressure, Pa";
-        case PreviewField::kDensity: return "density, kg/m3";
-        case PreviewField::kTemperature: return "temperature, C";
-    }
-    return "";
-}
-}  // namespace
 
 PreviewMesh solid_preview_mesh(const std::vector<std::array<double, 3>>& vertices,
                                const std::vector<std::array<int, 3>>& triangles) {

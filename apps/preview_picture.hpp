@@ -18,6 +18,9 @@ namespace mw {
 PreviewMesh solid_preview_mesh(const std::vector<std::array<double, 3>>& vertices,
                                const std::vector<std::array<int, 3>>& triangles);
 PreviewMesh surface_preview_mesh(const TriangleMesh& surface);
+// A rod drawn as a tube of `radius` (r0/2) round its line: a hexagonal prism per segment, each
+// ring square to the line there (the mean of its segments' directions).
+PreviewMesh rod_tube(const std::vector<std::array<double, 3>>& line, double radius);
 // The solids' meshes at this frame (SolidSetup GPs in `particles`; static objects: their rest mesh).
 std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& particles);
 

@@ -1,6 +1,5 @@
 #include "sampling/obj_loader.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -155,9 +154,9 @@ long long checked_vertex_index(const std::string& corner, const std::string& ele
 // and the reader is given only what was checked, written afresh: each vertex as "v x y z" with the
 // values already read (printed so that they read back exactly), each face as "f" and its vertex
 // indices. In a file without faces, polylines ("l", a rod's centreline) are checked the same way
-// and returned in `polylines` (0-based vertex indices), not given to the reader. Every other line (normals, texture
-// coordinates, groups, materials, skin weights, ...) the sampler does not use, and the reader never
-// sees.
+// and returned in `polylines` (0-based vertex indices), not given to the reader. Every other line
+// (normals, texture coordinates, groups, materials, skin weights, ...) the sampler does not use,
+// and the reader never sees.
 std::string checked_obj_text(const std::string& text, const std::string& source,
                              std::vector<std::vector<int>>& polylines) {
     // Faces may use vertices defined after them, so positive indices are checked against the
@@ -175,7 +174,7 @@ std::string checked_obj_text(const std::string& text, const std::string& source,
     for_each_element_line(text, [&](const ObjLine& line, char kind) {
         const std::vector<std::string> tokens = tokens_of(line.text, 2);
         if (kind == 'l') {
-            // A surface's stray edges (a file with faces) are not read, as before there were rods.
+            // In a file with faces the lines are a surface's stray edges: not read.
             if (total_faces > 0) return;
             ++lines;
             if (tokens.size() < 2) {
@@ -185,16 +184,18 @@ std::string checked_obj_text(const std::string& text, const std::string& source,
                 reject_line(source, line, problem.str());
             }
             std::vector<int> points;
+            std::vector<bool> visited(static_cast<std::size_t>(total_vertices), false);
             for (const std::string& point : tokens) {
                 const long long index =
                     checked_vertex_index(point, "line " + std::to_string(lines), vertices, total_vertices, source, line);
                 const int at = int(index > 0 ? index - 1 : vertices + index);
-                if (std::find(points.begin(), points.end(), at) != points.end()) {
+                if (visited[static_cast<std::size_t>(at)]) {
                     std::ostringstream problem;
-                    problem << "line " << lines << " visits vertex " << at + 1
-                            << " twice; a rod's line is open and does not cross itself";
+                    problem << "line " << lines << " visits vertex " << at + 1 << " twice; a rod's line is open, each "
+                            << "point once";
                     reject_line(source, line, problem.str());
                 }
+                visited[static_cast<std::size_t>(at)] = true;
                 points.push_back(at);
             }
             polylines.push_back(std::move(points));
