@@ -88,8 +88,8 @@ HostParticles frame_particles(const std::string& path) {
 }
 
 // The meshes written with frame `number`: each object's, then the fluid's surface. A rod's OBJ is
-// its line (one "l", no faces), drawn as the run's preview draws it: a tube of radius r0/2.
-std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number, double spacing) {
+// its line (one "l", no faces), drawn as the run's preview draws it: a tube of `rod_radius`.
+std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number, double rod_radius) {
     std::vector<PreviewMesh> meshes;
     std::vector<std::string> objects;
     for (const auto& entry : fs::directory_iterator(frames_dir)) {
@@ -105,7 +105,7 @@ std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number,
     for (const std::string& name : objects) {
         const TriangleMesh m = load_obj(frames_dir + "/" + name, false);
         if (m.triangles.empty() && m.vertices.size() > 1)
-            meshes.push_back(rod_tube(vertices_of(m), 0.5 * spacing));
+            meshes.push_back(rod_tube(vertices_of(m), rod_radius));
         else
             meshes.push_back(solid_preview_mesh(vertices_of(m), m.triangles));
     }
@@ -203,6 +203,7 @@ int command_render(int argc, char** argv) {
     const std::map<int, double> times = frame_times(frames_dir);
     const double scale = speed_scale(scene, frame_particles(first_frame));
     // The running count only where a person watches (a terminal), not into a log.
+    const double rod_radius = 0.5 * double(scene.params.fluid.spacing);
     const bool quiet = flag_option(args, "quiet");
     const bool counting = !quiet && isatty(fileno(stderr));
     std::string last;
@@ -212,7 +213,8 @@ int command_render(int argc, char** argv) {
         std::snprintf(name, sizeof name, "/particles_%05d.vtu", number);
         const HostParticles particles = frame_particles(frames_dir + name);
         const double time = times.count(number) ? times.at(number) : number / scene.fps;
-        const Image picture = preview_picture(scene, particles, frame_meshes(frames_dir, number, double(scene.params.fluid.spacing)), time, number, scale);
+        const Image picture = preview_picture(scene, particles, frame_meshes(frames_dir, number, rod_radius), time,
+                                              number, scale);
         std::snprintf(name, sizeof name, "/preview_%05d.png", number);
         last = out_dir + name;
         const std::string png = encode_png(picture);
@@ -222,7 +224,7 @@ int command_render(int argc, char** argv) {
     if (counting) std::fprintf(stderr, "\n");
     if (!quiet)
         std::printf("meltwater: %s in %s (the last: %s)\n", count_of(long(numbers.size()), "picture").c_str(),
-                out_dir.c_str(), last.c_str());
+                    out_dir.c_str(), last.c_str());
     return 0;
 }
 

@@ -122,7 +122,7 @@ void for_each_element_line(const std::string& text, Visit&& visit) {
 // The vertex index a face corner or a line point refers to ("v", "v/vt", "v//vn" or "v/vt/vn":
 // the vertex index comes first), as written, checked against the `vertices` before it (a
 // negative index counts back from there) and the file's `total_vertices`; `element` ("face 3",
-// "line 1") names it in the message. Read as long long, not int: an index beyond int (which the
+// "the line") names it in the message. Read as long long, not int: an index beyond int (which the
 // reader's atoi wraps) saturates and is reported as the number written.
 long long checked_vertex_index(const std::string& corner, const std::string& element, long long vertices,
                                long long total_vertices, const std::string& source, const ObjLine& line) {
@@ -153,12 +153,11 @@ long long checked_vertex_index(const std::string& corner, const std::string& ele
 // therefore checked here first, on the text, so each problem is reported with its line number;
 // and the reader is given only what was checked, written afresh: each vertex as "v x y z" with the
 // values already read (printed so that they read back exactly), each face as "f" and its vertex
-// indices. In a file without faces, polylines ("l", a rod's centreline) are checked the same way
-// and returned in `polylines` (0-based vertex indices), not given to the reader. Every other line
+// indices. In a file without faces, its one polyline ("l", a rod's centreline) is checked the same
+// way and returned in `polyline` (0-based vertex indices), not given to the reader. Every other line
 // (normals, texture coordinates, groups, materials, skin weights, ...) the sampler does not use,
 // and the reader never sees.
-std::string checked_obj_text(const std::string& text, const std::string& source,
-                             std::vector<std::vector<int>>& polylines) {
+std::string checked_obj_text(const std::string& text, const std::string& source, std::vector<int>& polyline) {
     // Faces may use vertices defined after them, so positive indices are checked against the
     // file's total, counted first.
     long long total_vertices = 0, total_faces = 0;
@@ -176,29 +175,26 @@ std::string checked_obj_text(const std::string& text, const std::string& source,
         if (kind == 'l') {
             // In a file with faces the lines are a surface's stray edges: not read.
             if (total_faces > 0) return;
-            ++lines;
+            if (++lines > 1)
+                reject_line(source, line, "a second line (\"l\"); a rod is one line: join them into one");
             if (tokens.size() < 2) {
                 std::ostringstream problem;
-                problem << "line " << lines << " has " << tokens.size() << " point" << (tokens.size() == 1 ? "" : "s")
+                problem << "the line has " << tokens.size() << " point" << (tokens.size() == 1 ? "" : "s")
                         << ", a line needs at least 2";
                 reject_line(source, line, problem.str());
             }
-            std::vector<int> points;
             std::vector<bool> visited(static_cast<std::size_t>(total_vertices), false);
             for (const std::string& point : tokens) {
-                const long long index =
-                    checked_vertex_index(point, "line " + std::to_string(lines), vertices, total_vertices, source, line);
+                const long long index = checked_vertex_index(point, "the line", vertices, total_vertices, source, line);
                 const int at = int(index > 0 ? index - 1 : vertices + index);
                 if (visited[static_cast<std::size_t>(at)]) {
                     std::ostringstream problem;
-                    problem << "line " << lines << " visits vertex " << at + 1 << " twice; a rod's line is open, each "
-                            << "point once";
+                    problem << "the line visits vertex " << at + 1 << " twice; a rod's line is open, each point once";
                     reject_line(source, line, problem.str());
                 }
                 visited[static_cast<std::size_t>(at)] = true;
-                points.push_back(at);
+                polyline.push_back(at);
             }
-            polylines.push_back(std::move(points));
             return;
         }
         if (kind == 'v') {
@@ -259,33 +255,24 @@ tinyobj::ObjReaderConfig config() {
     return c;
 }
 
-// A rod's centreline from an OBJ with one polyline ("l") and no faces: its points, in the
-// line's order, as a mesh of vertices and no triangles (as the procedural "line" is). `checked`
-// is checked_obj_text's output (the vertices as "v x y z" lines).
-TriangleMesh polyline_mesh(const std::string& checked, const std::string& source,
-                           const std::vector<std::vector<int>>& polylines) {
-    std::vector<Vec3d> vertices;
-    std::istringstream lines(checked);
-    for (std::string line; std::getline(lines, line);) {
-        if (line.rfind("v ", 0) != 0) continue;
-        std::istringstream values(line.substr(2));
-        Vec3d v;
-        values >> v.x() >> v.y() >> v.z();
-        vertices.push_back(v);
-    }
-    if (polylines.size() > 1)
-        throw InputError(source + ": the OBJ holds " + std::to_string(polylines.size()) +
-                         " lines (\"l\"); a rod is one line: join them into one");
+// A rod's centreline from an OBJ with one polyline ("l") and no faces: the reader's vertices (read
+// as a surface's are) in the line's order, as a mesh of vertices and no triangles (as the
+// procedural "line" is).
+TriangleMesh polyline_mesh(const tinyobj::ObjReader& reader, const std::string& source, const std::vector<int>& polyline) {
+    if (!reader.Valid()) throw InputError(source + ": cannot parse OBJ (" + first_line(reader.Error()) + ")");
+    const std::vector<tinyobj::real_t>& v = reader.GetAttrib().vertices;
     TriangleMesh mesh;
     mesh.source = source;
-    for (int k : polylines.front()) mesh.vertices.push_back(vertices[std::size_t(k)]);
-    for (std::size_t k = 0; k < mesh.vertices.size(); ++k)
-        if (mesh.vertices[k].cwiseAbs().maxCoeff() > kMaxCoordinate) {
+    for (int k : polyline) {
+        const Vec3d x(v[3 * std::size_t(k)], v[3 * std::size_t(k) + 1], v[3 * std::size_t(k) + 2]);
+        if (x.cwiseAbs().maxCoeff() > kMaxCoordinate) {
             std::ostringstream msg;
-            msg << source << ": point " << k + 1 << " of the line is out of range: coordinates must lie within +-"
-                << kMaxCoordinate;
+            msg << source << ": point " << mesh.vertices.size() + 1
+                << " of the line is out of range: coordinates must lie within +-" << kMaxCoordinate;
             throw InputError(msg.str());
         }
+        mesh.vertices.push_back(x);
+    }
     return mesh;
 }
 
@@ -304,12 +291,11 @@ TriangleMesh load_obj(const std::string& path, bool require_volume) {
 }
 
 TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume) {
-    std::vector<std::vector<int>> polylines;
-    const std::string checked = checked_obj_text(text, source, polylines);
-    if (!polylines.empty()) return polyline_mesh(checked, source, polylines);
+    std::vector<int> polyline;
+    const std::string checked = checked_obj_text(text, source, polyline);
     tinyobj::ObjReader reader;
     reader.ParseFromString(checked, std::string(), config());
-    return from_reader(reader, source, require_volume);
+    return polyline.empty() ? from_reader(reader, source, require_volume) : polyline_mesh(reader, source, polyline);
 }
 
 }  // namespace mw

@@ -39,6 +39,14 @@ Pixels png_pixels(const std::string& path) {
     return out;
 }
 
+// How many pixels of two pictures of the same size differ.
+std::size_t differing_pixels(const Pixels& a, const Pixels& b) {
+    std::size_t differing = 0;
+    for (std::size_t k = 0; k + 2 < a.size() && k + 2 < b.size(); k += 3)
+        differing += a[k] != b[k] || a[k + 1] != b[k + 1] || a[k + 2] != b[k + 2];
+    return differing;
+}
+
 std::string box_scene() { return tiny_scene_with_box("pictures_box.json"); }
 }  // namespace
 
@@ -81,10 +89,7 @@ TEST_CASE("render: a finished run's frames drawn again are the pictures the run 
         const Pixels drawn = png_pixels(dir + "/frames" + frame), again = png_pixels(dir + "/again" + frame);
         REQUIRE(drawn.size() == 960 * 540 * 3);
         REQUIRE(again.size() == drawn.size());
-        std::size_t differing = 0;
-        for (std::size_t k = 0; k < drawn.size(); k += 3)
-            differing += drawn[k] != again[k] || drawn[k + 1] != again[k + 1] || drawn[k + 2] != again[k + 2];
-        CHECK(differing < drawn.size() / 3 / 1000);
+        CHECK(differing_pixels(drawn, again) < drawn.size() / 3 / 1000);
     }
     // Another field and size, one frame: a different picture of the requested size.
     const Result pressure = run("render " + dir + " --frame 2 --field pressure --width 200 --height 100 --out " + dir +
@@ -124,10 +129,7 @@ TEST_CASE("render: a rod's frames are drawn as the run drew them, a tube round i
     REQUIRE(redrawn.size() == drawn.size());
     // The rod covers thousands of pixels (EPYC VM: 5,855 differ where render leaves it out, 1 with
     // it); read back from OBJ text at 7 digits, a few along its edges may differ.
-    std::size_t differing = 0;
-    for (std::size_t k = 0; k < drawn.size(); k += 3)
-        differing += drawn[k] != redrawn[k] || drawn[k + 1] != redrawn[k + 1] || drawn[k + 2] != redrawn[k + 2];
-    CHECK(differing < drawn.size() / 3 / 1000);
+    CHECK(differing_pixels(drawn, redrawn) < drawn.size() / 3 / 1000);
 }
 
 TEST_CASE("bad input: preview keys, info's --time-steps, and render's RUN_DIR and options") {

@@ -127,12 +127,13 @@ TEST_CASE("A bad OBJ polyline is refused with its line number") {
         return std::string("accepted");
     };
     const std::string points = "v 0 0 0\nv 0.1 0 0\nv 0.2 0 0\n";
-    CHECK(error(points + "l 1\n") == "rod.obj: line 1 has 1 point, a line needs at least 2 (line 4: 'l 1')");
-    CHECK(error(points + "l 1 2 7\n").find("line 1 refers to vertex 7, but the file has 3 vertices") != std::string::npos);
+    CHECK(error(points + "l 1\n") == "rod.obj: the line has 1 point, a line needs at least 2 (line 4: 'l 1')");
+    CHECK(error(points + "l 1 2 7\n").find("the line refers to vertex 7, but the file has 3 vertices") != std::string::npos);
     CHECK(error(points + "l 1 0\n").find("vertex 0") != std::string::npos);
     CHECK(error(points + "l 1 x\n").find("'x' is not a vertex index") != std::string::npos);
     CHECK(error(points + "l 1 -4\n").find("only 3 vertices precede it") != std::string::npos);
     CHECK(error(points + "l 1 2 3 1\n").find("visits vertex 1 twice") != std::string::npos);
-    CHECK(error(points + "l 1 2\nl 2 3\n").find("holds 2 lines") != std::string::npos);
+    CHECK(error(points + "l 1 2\nl 2 3\n") ==
+          "rod.obj: a second line (\"l\"); a rod is one line: join them into one (line 5: 'l 2 3')");
     CHECK(error(points + "l 1 2 3\n") == "accepted");
 }
