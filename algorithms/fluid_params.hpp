@@ -28,6 +28,9 @@ struct SolverParams {
     Real eta_max = 0;
     int min_iterations = 3;
     int max_iterations = 100;
+    // CFL mode: a step that held after more than this many PCISPH iterations lowers the largest
+    // step to 3/4 of itself (step_size.hpp); 0: off. Twice min_iterations by default.
+    int shorten_above_iterations = 6;
     // The longest step an elastic object's shape matching takes, s; 0: one per step (the paper's).
     // LSM's pull toward the goal is α (g - x)/Δt, so a body's sag under a load grows as Δt²: with
     // a positive value a longer step runs the solids in equal substeps no longer than it, and the
@@ -106,6 +109,12 @@ inline const ParamTable<SolverParams>& solver_keys() {
                                    "PCISPH iterations at least"));
         t.push_back(integer_key<T>("solver", "max_iterations", member(&T::max_iterations), 1, 10000,
                                    "PCISPH iterations at most (and at least min_iterations)"));
+        t.push_back(integer_key<T>("solver", "shorten_above_iterations", member(&T::shorten_above_iterations), 0, 10000,
+                                   "cfl mode: a step that needed more PCISPH iterations than this lowers the largest "
+                                   "step to 3/4 of itself (docs/solver.md); 0: off; else at least min_iterations")
+                        .derive_default(
+                            [](const ResolvedKeys& r) { return ParamValue::of(2 * r.number("solver.min_iterations")); },
+                            "2 x min_iterations"));
         t.push_back(number_key<T>("solver", "solid_substep", member(&T::solid_substep), ParamRange{0, 1, false, false},
                                   "s", "elastic objects' shape matching runs in substeps no longer than this (a pinned body's sag "
                                   "then does not depend on the step); 0: one per step (docs/lsm.md)"));

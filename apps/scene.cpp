@@ -304,6 +304,10 @@ void read_solver(Section s, Scene& scene) {
     if (p.max_iterations < p.min_iterations)
         s.fail(s.key_path("max_iterations"), "must be >= min_iterations (" + std::to_string(p.min_iterations) +
                                                  "), got " + std::to_string(p.max_iterations));
+    if (p.shorten_above_iterations != 0 && p.shorten_above_iterations < p.min_iterations)
+        s.fail(s.key_path("shorten_above_iterations"), "must be 0 (off) or >= min_iterations (" +
+                                                           std::to_string(p.min_iterations) + "), got " +
+                                                           std::to_string(p.shorten_above_iterations));
     s.read(scene_keys(), scene);
     s.finish();
 }

@@ -625,7 +625,7 @@ def write_outputs(rows, out_dir, device, command, quick):
         pts = [r for r in rows if r["case"] == c]
         lines += [f"## {c}", "", "| setting | error | ms per simulated s | iterations/step | steps | halvings | Pareto | details |",
                   "| --- | --- | --- | --- | --- | --- | --- | --- |"]
-        for r in sorted(pts, key=lambda r: (r["status"] != "ok", r.get("ms_per_simulated_s", 0))):
+        for r in sorted(pts, key=lambda r: (r["status"] != "ok", r.get("ms_per_simulated_s") or 0)):
             if r["status"] != "ok":
                 lines.append(f"| {r['setting']} | failed | | | | | | {r.get('message', '')[:160]} |")
                 continue
@@ -645,12 +645,8 @@ def write_outputs(rows, out_dir, device, command, quick):
         f.write("\n".join(lines))
 
 
-def replot(out_dir):
-    """Redraws sweep.png and report.md from out_dir/sweep.csv, keeping the report's device and command."""
-    path = os.path.join(out_dir or "", "sweep.csv")
-    if not out_dir or not os.path.isfile(path):
-        print(f"sweep.py: --replot needs a folder with a sweep.csv (got {out_dir!r})", file=sys.stderr)
-        return 2
+def read_rows(path):
+    """A sweep.csv's points, their numbers parsed."""
     rows = []
     for r in csv.DictReader(open(path)):
         for k in ("error", "ms_per_simulated_s", "iterations_per_step", "simulated_s", "wall_s", "r0"):
@@ -659,6 +655,16 @@ def replot(out_dir):
             r[k] = int(float(r[k])) if r.get(k) else None
         r["pareto"] = False
         rows.append(r)
+    return rows
+
+
+def replot(out_dir):
+    """Redraws sweep.png and report.md from out_dir/sweep.csv, keeping the report's device and command."""
+    path = os.path.join(out_dir or "", "sweep.csv")
+    if not out_dir or not os.path.isfile(path):
+        print(f"sweep.py: --replot needs a folder with a sweep.csv (got {out_dir!r})", file=sys.stderr)
+        return 2
+    rows = read_rows(path)
     report = os.path.join(out_dir, "report.md")
     head = open(report).read().splitlines() if os.path.isfile(report) else []
     device = next((l.split(": ", 1)[1].split(", OpenMP")[0] for l in head if l.startswith("- device: ")), device_name())
@@ -679,6 +685,9 @@ def main():
     parser.add_argument("--threads", type=int, default=0, help="OpenMP threads (default: all cores)")
     parser.add_argument("--timeout", type=int, default=900, help="seconds a point may take (default 900)")
     parser.add_argument("--replot", action="store_true", help="redraw OUT's plot and report from its sweep.csv")
+    parser.add_argument("--only", help="only the settings whose label contains this text (e.g. CFL)")
+    parser.add_argument("--base", help="a sweep folder whose other points complete this run's (rerun the points a "
+                                       "change touches)")
     parser.add_argument("--point", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.point:
@@ -705,6 +714,8 @@ def main():
     os.makedirs(out_dir, exist_ok=True)
     points = [("defaults", "defaults", {})] if args.smoke else settings(args.quick)
     plan = [(c, label, group, change) for c in cases for label, group, change in points if applies(c, change)]
+    if args.only:
+        plan = [p for p in plan if args.only in p[1]]
     if args.double_build:
         plan += [(c, "defaults, double", "precision", {"__build": args.double_build}) for c in cases]
     rows = []
@@ -724,6 +735,11 @@ def main():
             if result["status"] == "ok" else f"failed: {result.get('message', '')[:120]}"
         print(f"[{n}/{len(plan)}, {time.monotonic() - started:.0f} s] {case}, {label}: {shown}", flush=True)
     command = "bench/sweep.py " + " ".join(a for a in sys.argv[1:])
+    if args.base:
+        rerun = {(r["case"], r["setting"]) for r in rows}
+        kept = [r for r in read_rows(os.path.join(args.base, "sweep.csv")) if (r["case"], r["setting"]) not in rerun]
+        rows = kept + rows
+        command += f" (the other {len(kept)} points from {args.base})"
     write_outputs(rows, out_dir, device, f"`{command.strip()}`", args.quick)
     print(f"sweep.py: {len(rows)} points; results in {out_dir} (sweep.csv, sweep.png, report.md)")
     failed = sum(r["status"] != "ok" for r in rows)

@@ -85,6 +85,7 @@ TEST_CASE("defaults are filled in and recorded in the resolved scene") {
     CHECK(s.params.solver.eta_max == doctest::Approx(0.05));  // 5 eta
     CHECK(s.params.solver.min_iterations == 3);
     CHECK(s.params.solver.max_iterations == 100);
+    CHECK(s.params.solver.shorten_above_iterations == 6);  // 2 min_iterations
     CHECK(s.params.neighbors.ordering == CellOrdering::kZOrder);
     CHECK(s.boundary_spacing_factor == doctest::Approx(0.5));
     CHECK(s.boundary_layers == 1);
@@ -183,6 +184,8 @@ TEST_CASE("bad scenes give one line naming the key") {
         {"non-integer", tiny, {"boundary.layers=1.5"}, {"boundary.layers", "integer"}},
         {"layers out of range", tiny, {"boundary.layers=9"}, {"boundary.layers", "[1, 8]"}},
         {"iterations inverted", tiny, {"solver.max_iterations=2"}, {"solver.max_iterations", "min_iterations"}},
+        {"shortening below the least iterations", tiny, {"solver.shorten_above_iterations=2"},
+         {"solver.shorten_above_iterations", "0 (off) or >= min_iterations (3)", "got 2"}},
         {"bad choice", tiny, {"solver.dt_mode=adaptive"}, {"solver.dt_mode", "fixed, cfl", "adaptive"}},
         {"unknown kernel", tiny, {"fluid.kernel=quintic"}, {"fluid.kernel", "cubic_spline, wendland_c2", "quintic"}},
         {"bad format", tiny, {"output.formats=[\"obj\"]"}, {"output.formats[0]", "vtu"}},

@@ -44,7 +44,7 @@ double total_energy(const HostParticles& h, double fluid_mass, double ibp_mass) 
 
 // A 0.4 x 0.2 x 0.24 m pool in a 0.4 x 0.6 x 0.24 m tank; the cube's bottom starts 0.1 m above
 // the water and is thrown straight down at 5 m/s; 1.2 s.
-Throw throw_into_pool(SolidKind kind, double density, Real cfl, bool strong = true) {
+Throw throw_into_pool(SolidKind kind, double density, Real cfl, bool strong = true, bool shorten = true) {
     SimulationSetup setup = test::fluid_in_box({0, 0, 0}, {0.4f, 0.6f, 0.24f}, {0, 0, 0}, {0.4f, 0.2f, 0.24f}, kR0, 0.03f);
     setup.params.solver.dt_mode = TimeStepMode::kCfl;
     setup.params.solver.cfl_number = cfl;
@@ -52,6 +52,7 @@ Throw throw_into_pool(SolidKind kind, double density, Real cfl, bool strong = tr
     setup.params.fluid.viscosity = 0.01f;
     setup.params.coupling.two_way = true;
     setup.params.coupling.strong = strong;
+    if (!shorten) setup.params.solver.shorten_above_iterations = 0;
     SolidSetup solid;
     solid.name = "cube";
     solid.kind = kind;
@@ -158,9 +159,11 @@ TEST_CASE("the extremes, elastic: 500 kg/m3 thrown into a pool at 5 m/s, CFL 0.4
 // What the rigid objects' answer inside PCISPH (coupling.strong) holds: without it the
 // 10,000 kg/m3 cube, met in every iteration as if it kept its velocity through the step, gains
 // energy where it lands (measured on the EPYC VM: 19% of the scene's at CFL 0.4, 10% at CFL 1;
-// none with it).
+// none with it). Run as the step rule was before long solves shortened the step
+// (solver.shorten_above_iterations, which the answer's steps do not read): with the rule and
+// without the answer the cube runs away on the floor (3.2 times the scene's energy gained).
 TEST_CASE("without coupling.strong the 10,000 kg/m3 rigid cube gains energy landing on the floor") {
-    const Throw t = throw_into_pool(SolidKind::kRigid, 10000, 0.4f, false);
+    const Throw t = throw_into_pool(SolidKind::kRigid, 10000, 0.4f, false, false);
     MESSAGE("energy gain " << t.energy_gain << " of the scene's; centre " << t.centroid_y << " m");
     CHECK(t.finished);
     CHECK(t.energy_gain > 0.05);
