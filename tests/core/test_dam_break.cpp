@@ -189,11 +189,11 @@ TEST_CASE("dam break against Martin & Moyce with the Wendland C2 kernel: the sam
 // The speed/accuracy trade of the time step, against the same published data: CFL number 1 with
 // the paper's 30 ms as the largest step. Measured: 104 steps to τ = 1.84 (263 at the fixed 1 ms
 // above), 4 halvings of a step, 682 PCISPH iterations (789 at 1 ms); heights within 1.9%, the
-// front 15.3% ahead at T = 1.19 (1 ms: 1.8% and 16.3%). Before long solves shortened the step
-// (solver.shorten_above_iterations): 91 steps, 7 halvings, 810 iterations, heights within 2.0%.
+// front 15.3% ahead at T = 1.19 (1 ms: 1.8% and 16.3%). With solver.shorten_above_iterations
+// off: 91 steps, 7 halvings, 810 iterations, heights within 2.0%.
 // Without the peak bound (eta_max 0) the front was at the far wall by T = 0.41 (at CFL 0.4 under
 // 30 ms, by T = 1.43). No step here runs out of iterations: the halvings are of diverging tries,
-// and the run was the same without the retry of unconverged steps (measured before the rule).
+// and with the rule off the run is the same without the retry of unconverged steps (measured).
 TEST_CASE("dam break against Martin & Moyce at CFL number 1 and a 30 ms largest step: the same bounds, under half the steps") {
     const long steps = check_against_martin_moyce(KernelKind::kCubicSpline, 2, {Real(1), Real(0.03)}).steps;
     CHECK(steps < 263 / 2);  // 263: the fixed 1 ms run's steps to the same end (the first case)

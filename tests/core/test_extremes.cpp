@@ -159,9 +159,9 @@ TEST_CASE("the extremes, elastic: 500 kg/m3 thrown into a pool at 5 m/s, CFL 0.4
 // What the rigid objects' answer inside PCISPH (coupling.strong) holds: without it the
 // 10,000 kg/m3 cube, met in every iteration as if it kept its velocity through the step, gains
 // energy where it lands (measured on the EPYC VM: 19% of the scene's at CFL 0.4, 10% at CFL 1;
-// none with it). Run as the step rule was before long solves shortened the step
-// (solver.shorten_above_iterations, which the answer's steps do not read): with the rule and
-// without the answer the cube runs away on the floor (3.2 times the scene's energy gained).
+// none with it). Run with solver.shorten_above_iterations off (the answer's steps do not read it,
+// so with the answer it changes nothing): with the rule on and without the answer the cube runs
+// away on the floor (3.2 times the scene's energy gained).
 TEST_CASE("without coupling.strong the 10,000 kg/m3 rigid cube gains energy landing on the floor") {
     const Throw t = throw_into_pool(SolidKind::kRigid, 10000, 0.4f, false, false);
     MESSAGE("energy gain " << t.energy_gain << " of the scene's; centre " << t.centroid_y << " m");

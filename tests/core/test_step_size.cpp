@@ -41,7 +41,7 @@ TEST_CASE("the step's limit: a step past solver.shorten_above_iterations shorten
     StepSizeControl at_threshold;
     at_threshold.after_step(params.solver, 0, true, 0.004, params.solver.shorten_above_iterations);
     CHECK(at_threshold.next(params, 0) == doctest::Approx(0.005));
-    // A retried step sets the limit to the step that held, as before; the iterations do not matter.
+    // A retried step sets the limit to the step that held; its iterations do not matter.
     StepSizeControl retried;
     retried.after_step(params.solver, 2, true, 0.00125, 40);
     CHECK(retried.next(params, 0) == doctest::Approx(0.00125));
