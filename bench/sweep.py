@@ -700,6 +700,10 @@ def main():
     if unknown:
         print(f"sweep.py: unknown case {unknown[0]!r} (cases: {', '.join(CASES)})", file=sys.stderr)
         return 2
+    if args.base and not os.path.isfile(os.path.join(args.base, "sweep.csv")):
+        # Checked before any point runs: the base is read only once the run's points are done.
+        print(f"sweep.py: --base needs a sweep folder with a sweep.csv (got {args.base!r})", file=sys.stderr)
+        return 2
     pythonpath = os.path.join(os.path.abspath(args.build), "python")
     if not any(n.startswith("meltwater") for n in (os.listdir(pythonpath) if os.path.isdir(pythonpath) else [])):
         print(f"sweep.py: no Python module in {pythonpath}: build it (cmake --build {args.build} --target "

@@ -1,6 +1,6 @@
 # bench/sweep.py, the speed–accuracy sweep: its Pareto front and purposes on made-up points, and
 # its whole pipeline (every case cut short, in child processes) writing the CSV, plot and report,
-# and --replot redrawing them from the CSV.
+# --replot redrawing them from the CSV, and --only with --base rerunning one point into them.
 import csv
 import importlib.util
 import math
@@ -57,6 +57,15 @@ def test_a_smoke_sweep_writes_the_csv_the_plot_and_the_report(tmp_path):
     assert again.returncode == 0, again.stderr
     assert (out / "report.md").read_text() == report
     assert (out / "sweep.png").stat().st_size > 10_000
+    # --only and --base: one point run again, every other taken from the first sweep.
+    merged = tmp_path / "merged"
+    rerun = subprocess.run([sys.executable, str(REPO / "bench" / "sweep.py"), "--smoke", "--threads", "1",
+                            "--cases", "dam_break", "--only", "defaults", "--base", str(out), str(merged),
+                            "--build", str(pathlib_build())], capture_output=True, text=True, env=env, timeout=600)
+    assert rerun.returncode == 0, rerun.stderr + rerun.stdout
+    merged_rows = list(csv.DictReader(open(merged / "sweep.csv")))
+    assert sorted(r["case"] for r in merged_rows) == sorted(sweep.CASES)
+    assert f"the other {len(rows) - 1} points from {out}" in (merged / "report.md").read_text()
 
 
 def test_an_unknown_case_is_refused_in_one_line(tmp_path):
@@ -64,6 +73,14 @@ def test_an_unknown_case_is_refused_in_one_line(tmp_path):
                           capture_output=True, text=True)
     assert done.returncode == 2
     assert done.stderr.strip().count("\n") == 0 and "unknown case 'nonsense'" in done.stderr
+
+
+def test_a_missing_base_is_refused_in_one_line_before_any_point_runs(tmp_path):
+    done = subprocess.run([sys.executable, str(REPO / "bench" / "sweep.py"), "--base", str(tmp_path / "none"),
+                           str(tmp_path / "out")], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert done.stderr.strip().count("\n") == 0 and "--base needs a sweep folder with a sweep.csv" in done.stderr
+    assert not (tmp_path / "out").exists()
 
 
 def pathlib_build():
