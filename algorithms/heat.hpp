@@ -202,7 +202,7 @@ class HeatConduction final : public Module {
         object_heat_.upload(materials);
         max_substeps_ = params.heat.max_substeps;
         // Brookshaw's Laplacian, rescaled to be exact on the fluid's lattice (pcisph_delta.hpp).
-        lattice_scale_ = heat_lattice_scale(prototype_sums(state.fluid.kernel, params.fluid.spacing, 3));
+        lattice_scale_ = heat_lattice_scale(prototype_sums(state.fluid.kernel, params.fluid.spacing, Kernel::kDimensions));
         particle_.assign(moving, HeatParticle{});
         other_.assign(moving, Real(0));
         solid_rest_volume_.assign(1, Real(0));  // start() sizes it

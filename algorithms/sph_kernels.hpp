@@ -31,7 +31,7 @@ template <class Profile>
 struct RadialKernel {
     Real h = 1;
     Real inv_h = 1;
-    Real visc_scale = 0;  // 45 / (π h⁶)
+    Real visc_scale = 0;  // 45 / (π h⁶) in 3D, 40 / (π h⁵) in 2D
 
     MW_INLINE Real W(Real r) const { return profile().W_of_q(r * inv_h); }
     // ∇_i W(x_i - x_j) for r_vec = x_i - x_j, |r_vec| = r (passed in because callers have it).
@@ -69,26 +69,41 @@ struct RadialKernel {
     }
 
    protected:
+    // The viscosity Laplacian's constant is that of Müller et al.'s kernel normalised in the
+    // profile's dimensions: 45/(π h⁶) in 3D, 40/(π h⁵) in 2D.
     void set_support(Real support) {
         h = support;
         inv_h = Real(1) / support;
-        visc_scale = Real(45) / (kPi * support * support * support * support * support * support);
+        if constexpr (Profile::kDimensions == 3)
+            visc_scale = Real(45) / (kPi * support * support * support * support * support * support);
+        else
+            visc_scale = Real(40) / (kPi * support * support * support * support * support);
     }
 
    private:
     MW_INLINE const Profile& profile() const { return static_cast<const Profile&>(*this); }
 };
 
-// Cubic spline (Monaghan) with compact support h: W > 0 for r < h. Normalised in 3D.
-struct CubicSpline3D : RadialKernel<CubicSpline3D> {
-    Real sigma = 0;       // 8 / (π h³)
-    Real grad_scale = 0;  // 48 / (π h⁴)
+// Cubic spline (Monaghan) with compact support h: W > 0 for r < h, normalised in D dimensions
+// (2 or 3): σ = 8/(π h³) in 3D, 40/(7π h²) in 2D. A 2D scene's particles lie in the plane z = 0
+// and its sums run over a plane's neighbours; masses and volumes are then per unit depth.
+template <int D>
+struct CubicSpline : RadialKernel<CubicSpline<D>> {
+    static_assert(D == 2 || D == 3);
+    static constexpr int kDimensions = D;
+    Real sigma = 0;
+    Real grad_scale = 0;  // 6 σ / h: 48/(π h⁴) in 3D, 240/(7π h³) in 2D
 
-    static CubicSpline3D with_support(Real support) {
-        CubicSpline3D k;
+    static CubicSpline with_support(Real support) {
+        CubicSpline k;
         k.set_support(support);
-        k.sigma = Real(8) / (kPi * support * support * support);
-        k.grad_scale = Real(48) / (kPi * support * support * support * support);
+        if constexpr (D == 3) {
+            k.sigma = Real(8) / (kPi * support * support * support);
+            k.grad_scale = Real(48) / (kPi * support * support * support * support);
+        } else {
+            k.sigma = Real(40) / (Real(7) * kPi * support * support);
+            k.grad_scale = Real(240) / (Real(7) * kPi * support * support * support);
+        }
         return k;
     }
     // The two pieces without branches (selects only): a = max(1-q, 0), b = max(1/2-q, 0);
@@ -107,15 +122,22 @@ struct CubicSpline3D : RadialKernel<CubicSpline3D> {
     }
 };
 
-// Wendland C2 with compact support h, normalised in 3D: W = 21/(2π h³) (1-q)⁴ (1+4q).
-struct WendlandC2_3D : RadialKernel<WendlandC2_3D> {
-    Real sigma = 0;       // 21 / (2π h³)
-    Real grad_scale = 0;  // 20 σ / h = 210 / (2π h⁴)
+// Wendland C2 with compact support h, normalised in D dimensions: W = σ (1-q)⁴ (1+4q) with
+// σ = 21/(2π h³) in 3D, 7/(π h²) in 2D.
+template <int D>
+struct WendlandC2 : RadialKernel<WendlandC2<D>> {
+    static_assert(D == 2 || D == 3);
+    static constexpr int kDimensions = D;
+    Real sigma = 0;
+    Real grad_scale = 0;  // 20 σ / h
 
-    static WendlandC2_3D with_support(Real support) {
-        WendlandC2_3D k;
+    static WendlandC2 with_support(Real support) {
+        WendlandC2 k;
         k.set_support(support);
-        k.sigma = Real(21) / (Real(2) * kPi * support * support * support);
+        if constexpr (D == 3)
+            k.sigma = Real(21) / (Real(2) * kPi * support * support * support);
+        else
+            k.sigma = Real(7) / (kPi * support * support);
         k.grad_scale = Real(20) * k.sigma / support;
         return k;
     }
@@ -131,8 +153,14 @@ struct WendlandC2_3D : RadialKernel<WendlandC2_3D> {
     }
 };
 
+using CubicSpline3D = CubicSpline<3>;
+using CubicSpline2D = CubicSpline<2>;
+using WendlandC2_3D = WendlandC2<3>;
+using WendlandC2_2D = WendlandC2<2>;
+
 // Kernels are captured by value in device lambdas.
-static_assert(std::is_trivially_copyable_v<CubicSpline3D> && std::is_trivially_copyable_v<WendlandC2_3D>);
+static_assert(std::is_trivially_copyable_v<CubicSpline3D> && std::is_trivially_copyable_v<WendlandC2_3D> &&
+              std::is_trivially_copyable_v<CubicSpline2D> && std::is_trivially_copyable_v<WendlandC2_2D>);
 
 // Calls f(kernel) with the 3D kernel of `kind` and support h: where host code (the wall gap, a
 // factory) turns the scene's choice into the type the solver is written against.
@@ -142,38 +170,14 @@ decltype(auto) with_kernel(KernelKind kind, Real support, F&& f) {
     return f(CubicSpline3D::with_support(support));
 }
 
-// Cubic spline normalised in 2D (for 2D scenes and the 2D δ check).
-struct CubicSpline2D {
-    Real h = 1;
-    Real sigma = 0;        // 40 / (7 π h²)
-    Real grad_scale = 0;   // 240 / (7 π h³)
-
-    static CubicSpline2D with_support(Real support) {
-        CubicSpline2D k;
-        k.h = support;
-        k.sigma = Real(40) / (Real(7) * kPi * support * support);
-        k.grad_scale = Real(240) / (Real(7) * kPi * support * support * support);
-        return k;
+// The same with the scene's dimensions (2 or 3).
+template <class F>
+decltype(auto) with_kernel(KernelKind kind, int dimensions, Real support, F&& f) {
+    if (dimensions == 2) {
+        if (kind == KernelKind::kWendlandC2) return f(WendlandC2_2D::with_support(support));
+        return f(CubicSpline2D::with_support(support));
     }
-    MW_INLINE Real W(Real r) const {
-        const Real q = r / h;
-        if (q >= Real(1)) return Real(0);
-        if (q <= Real(0.5)) return sigma * (Real(6) * (q * q * q - q * q) + Real(1));
-        const Real t = Real(1) - q;
-        return sigma * Real(2) * t * t * t;
-    }
-    MW_INLINE Vec3 grad_W(Vec3 r_vec, Real r) const {
-        const Real q = r / h;
-        if (q >= Real(1) || r <= Real(1e-9) * h) return Vec3{0, 0, 0};
-        Real dwdq;
-        if (q <= Real(0.5))
-            dwdq = q * (Real(3) * q - Real(2));
-        else {
-            const Real t = Real(1) - q;
-            dwdq = -t * t;
-        }
-        return (grad_scale * dwdq / r) * r_vec;
-    }
-};
+    return with_kernel(kind, support, f);
+}
 
 }  // namespace mw

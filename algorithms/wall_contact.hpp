@@ -88,9 +88,15 @@ struct StaticBoxFaces {
 };
 
 // The band of a static box: as a wall's, and no wider than the carve lets fluid start.
-inline ContactBox contact_box(const StaticBoxFaces& box, Real r0) {
+// In 2D the box is a rectangle in the plane, unbounded along z (no face normal to z).
+inline ContactBox contact_box(const StaticBoxFaces& box, Real r0, int dimensions = 3) {
     const Real band = contact_distance(box.layer_gap, r0);
-    return ContactBox{box.lo, box.hi, band < box.carve_distance ? band : box.carve_distance};
+    ContactBox c{box.lo, box.hi, band < box.carve_distance ? band : box.carve_distance};
+    if (dimensions == 2) {
+        c.lo.z = -std::numeric_limits<Real>::infinity();
+        c.hi.z = std::numeric_limits<Real>::infinity();
+    }
+    return c;
 }
 
 // A static mesh object's signed distance (values in backend memory), and how far from its surface
@@ -128,12 +134,17 @@ struct WallContact {
     View<const Real> object_distances;  // every object's grid values, one after another
 
     // For a domain [domain_lo, domain_hi] whose walls' first layer lies `gap` outside the faces.
-    static WallContact for_domain(Vec3 domain_lo, Vec3 domain_hi, Real gap, Real r0) {
+    // A 2D domain has no walls normal to z: its band there is unbounded.
+    static WallContact for_domain(Vec3 domain_lo, Vec3 domain_hi, Real gap, Real r0, int dimensions = 3) {
         const Real contact = contact_distance(gap, r0);
         const Real inward = contact - gap;  // from the face into the domain (negative: outside it)
         WallContact c;
         c.lo = Vec3{domain_lo.x + inward, domain_lo.y + inward, domain_lo.z + inward};
         c.hi = Vec3{domain_hi.x - inward, domain_hi.y - inward, domain_hi.z - inward};
+        if (dimensions == 2) {
+            c.lo.z = -std::numeric_limits<Real>::infinity();
+            c.hi.z = std::numeric_limits<Real>::infinity();
+        }
         return c;
     }
 

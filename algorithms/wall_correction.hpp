@@ -21,13 +21,15 @@ class WallCorrection final : public Module {
         if (params.boundary.walls) {
             if (!(params.boundary.wall_gap >= 0))
                 throw InputError("simulation setup: the domain walls' correction needs the walls' gap (params.boundary.wall_gap)");
-            walls_ = WallContact::for_domain(params.domain_min, params.domain_max, params.boundary.wall_gap, r0);
+            walls_ = WallContact::for_domain(params.domain_min, params.domain_max, params.boundary.wall_gap, r0,
+                                             params.dimensions);
         }
         // Boxes and objects keep fluid out; without fluid there is nothing to keep.
         if (!has_fluid) return;
         if (!params.boundary.static_boxes.empty()) {
             std::vector<ContactBox> boxes;
-            for (const StaticBoxFaces& b : params.boundary.static_boxes) boxes.push_back(contact_box(b, r0));
+            for (const StaticBoxFaces& b : params.boundary.static_boxes)
+                boxes.push_back(contact_box(b, r0, params.dimensions));
             boxes_.upload(boxes);
             walls_.boxes = boxes_.cview();
         }

@@ -26,6 +26,8 @@ struct WallMirrors {
     Real reach = 0;                 // h: images of particles farther than this from a face never count
 
     static constexpr unsigned kAllFaces = 0x3f;
+    // The walls of a domain in `dimensions` (2: the four faces normal to x and y).
+    static constexpr unsigned faces_in(int dimensions) { return dimensions == 2 ? 0x0fu : kAllFaces; }
 
     // Calls f(scale, offset) once for every reflection, across one face or several, whose images
     // can come within `reach` of x; nothing for a particle farther than `reach` from every wall.

@@ -28,7 +28,7 @@ const char* kDefaultScene =
 // ---- The program's own keys -----------------------------------------------------------------
 
 // The preview camera that frames the domain read so far (render/preview.hpp's default_camera), for
-// output.preview.width / height pictures.
+// output.preview.width / height pictures; head-on in 2D.
 struct DefaultView {
     Vec3 eye, target;
 };
@@ -37,7 +37,8 @@ DefaultView default_view(const ResolvedKeys& r) {
     const double width = r.number("output.preview.width"), height = r.number("output.preview.height");
     if (!lo || !hi || !(height > 0)) return {Vec3{0, 0, 1}, Vec3{0, 0, 0}};
     const PreviewCamera c = default_camera({lo->vector[0], lo->vector[1], lo->vector[2]},
-                                           {hi->vector[0], hi->vector[1], hi->vector[2]}, width / height);
+                                           {hi->vector[0], hi->vector[1], hi->vector[2]}, width / height,
+                                           r.dimensions == 2);
     const auto vec = [](const PreviewVec& v) { return Vec3{Real(v[0]), Real(v[1]), Real(v[2])}; };
     return {vec(c.eye), vec(c.target)};
 }
@@ -190,7 +191,8 @@ const ParamTable<SceneObject>& object_keys() {
 // Keys read by hand (their checks relate them to other keys), documented here beside the tables.
 std::vector<ParamDoc> keys_read_by_hand() {
     return {
-        {"dimensions", "integer", "3", "3", "", "the scene's dimensions"},
+        {"dimensions", "integer", "3", "2 or 3", "",
+         "2: particles in the plane z = 0, vectors [x, y]; fluid blocks, static boxes, emitters and walls"},
         {"objects[].name", "string", "\"object<i>\"", "letters, digits, _ and -; unique", "",
          "names the object's output files"},
         {"emitters[].name", "string", "\"emitter<i>\"", "letters, digits, _ and -; unique", "", "names it in info"},
@@ -218,18 +220,21 @@ std::string describe_point(Vec3 p) {
 
 namespace {
 
-void check_box(const Section& s, Vec3 lo, Vec3 hi) {
-    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) s.fail(s.key_path("max"), "must exceed min on every axis");
+// A 2D scene's boxes are rectangles in the plane z = 0.
+void check_box(const Section& s, Vec3 lo, Vec3 hi, int dimensions = 3) {
+    if (!(hi.x > lo.x && hi.y > lo.y && (dimensions == 2 || hi.z > lo.z)))
+        s.fail(s.key_path("max"), "must exceed min on every axis");
 }
 
-bool inside(Vec3 lo, Vec3 hi, Vec3 dlo, Vec3 dhi) {
+// In 2D only x and y: a z off the plane gets check_plane()'s message.
+bool inside(Vec3 lo, Vec3 hi, Vec3 dlo, Vec3 dhi, int dimensions) {
     const Real eps = Real(1e-6);
-    return lo.x >= dlo.x - eps && lo.y >= dlo.y - eps && lo.z >= dlo.z - eps && hi.x <= dhi.x + eps &&
-           hi.y <= dhi.y + eps && hi.z <= dhi.z + eps;
+    const bool inside_z = dimensions == 2 || (lo.z >= dlo.z - eps && hi.z <= dhi.z + eps);
+    return lo.x >= dlo.x - eps && lo.y >= dlo.y - eps && hi.x <= dhi.x + eps && hi.y <= dhi.y + eps && inside_z;
 }
 
 void check_inside_domain(const Section& s, const Scene& scene, Vec3 lo, Vec3 hi, const char* what) {
-    if (!inside(lo, hi, scene.params.domain_min, scene.params.domain_max))
+    if (!inside(lo, hi, scene.params.domain_min, scene.params.domain_max, scene.params.dimensions))
         s.fail(s.path(), std::string("the ") + what + " must lie inside the domain " +
                              describe_box(scene.params.domain_min, scene.params.domain_max));
 }
@@ -240,7 +245,8 @@ void check_inside_domain(const Section& s, const Scene& scene, Vec3 lo, Vec3 hi,
 void check_clear_of_fluid_blocks(const Section& s, const Scene& scene, Vec3 lo, Vec3 hi) {
     for (std::size_t k = 0; k < scene.fluid_blocks.size(); ++k) {
         const FluidBlock& f = scene.fluid_blocks[k];
-        if (lo.x < f.max.x && f.min.x < hi.x && lo.y < f.max.y && f.min.y < hi.y && lo.z < f.max.z && f.min.z < hi.z)
+        const bool overlap_z = scene.params.dimensions == 2 || (lo.z < f.max.z && f.min.z < hi.z);
+        if (lo.x < f.max.x && f.min.x < hi.x && lo.y < f.max.y && f.min.y < hi.y && overlap_z)
             s.fail(s.path(), "overlaps fluid_blocks[" + std::to_string(k) + "] " + describe_box(f.min, f.max) +
                                  "; blocks may touch but not overlap");
     }
@@ -269,6 +275,20 @@ std::string read_unique_name(Section& s, const std::string& fallback, const std:
 // ---- One function per section -----------------------------------------------------------------
 
 void read_root(Section& root, Scene& scene) {
+    // First: a 2D scene's vectors, the root's own among them, are read as [x, y].
+    if (const SceneJson* d = root.find("dimensions")) {
+        if (!d->is_number()) root.fail("dimensions", "expected a number, got " + json_type_name(*d));
+        const double value = d->get<double>();
+        if (value != 2 && value != 3) root.fail("dimensions", "expected 2 or 3, got " + format_scene_number(value));
+        scene.params.dimensions = static_cast<int>(value);
+    }
+    root.resolved().dimensions = scene.params.dimensions;
+    root.record("dimensions", scene.params.dimensions);
+    // What 2D scenes hold so far: fluid blocks in a walled domain.
+    if (scene.params.dimensions == 2)
+        for (const char* key : {"objects", "pressure_sensors"})
+            if (const SceneJson* v = root.find(key); v && !(v->is_array() && v->empty()))
+                root.fail(key, "not available in 2D scenes yet (they take fluid_blocks, static_boxes, emitters and the domain walls)");
     root.read(scene_keys(), scene);
     // The name becomes the default output directory results/<name>: no path separators or dots
     // that would lead elsewhere, nothing a shell or a terminal would mangle.
@@ -276,18 +296,11 @@ void read_root(Section& root, Scene& scene) {
         std::string::npos)
         root.fail("name", "use letters, digits, '_' and '-' only (it names the output directory), got \"" +
                               scene.name + "\"");
-    // Only 3D scenes exist: any other value is refused.
-    if (const SceneJson* d = root.find("dimensions")) {
-        if (!d->is_number()) root.fail("dimensions", "expected a number, got " + json_type_name(*d));
-        if (d->get<double>() != 3)
-            root.fail("dimensions", "only 3 is supported, got " + format_scene_number(d->get<double>()));
-    }
-    root.record("dimensions", 3);
 }
 
 void read_domain(Section s, Scene& scene) {
     s.read(scene_keys(), scene);
-    check_box(s, scene.params.domain_min, scene.params.domain_max);
+    check_box(s, scene.params.domain_min, scene.params.domain_max, scene.params.dimensions);
     s.finish();
 }
 
@@ -324,7 +337,7 @@ void read_fluid_blocks(Section& root, Scene& scene) {
     root.array_of_objects("fluid_blocks", [&](Section& s, int) {
         FluidBlock b;
         s.read(block_keys(), b);
-        check_box(s, b.min, b.max);
+        check_box(s, b.min, b.max, scene.params.dimensions);
         check_inside_domain(s, scene, b.min, b.max, "block");
         check_clear_of_fluid_blocks(s, scene, b.min, b.max);
         scene.fluid_blocks.push_back(b);
@@ -335,7 +348,7 @@ void read_static_boxes(Section& root, Scene& scene) {
     root.array_of_objects("static_boxes", [&](Section& s, int) {
         StaticBox b;
         s.read(box_keys(), b);
-        check_box(s, b.min, b.max);
+        check_box(s, b.min, b.max, scene.params.dimensions);
         check_inside_domain(s, scene, b.min, b.max, "box");
         scene.static_boxes.push_back(b);
     });
@@ -417,7 +430,7 @@ void check_emitter_disc(const Section& s, const Scene& scene, const SceneEmitter
     const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
     const double n[3] = {e.direction.x, e.direction.y, e.direction.z}, c[3] = {e.center.x, e.center.y, e.center.z},
                  low[3] = {lo.x, lo.y, lo.z}, high[3] = {hi.x, hi.y, hi.z};
-    for (int a = 0; a < 3; ++a) {
+    for (int a = 0; a < scene.params.dimensions; ++a) {  // in 2D a segment in the plane
         // How far the disc reaches along axis a: radius x sin(angle between the axis and its normal).
         const double extent = radius * std::sqrt(std::max(0.0, 1 - n[a] * n[a]));
         if (c[a] - extent < low[a] + margin || c[a] + extent > high[a] - margin)
@@ -504,6 +517,40 @@ void check_surface_voxel(const Scene& scene) {
     }
 }
 
+// A 2D scene lies in the plane z = 0: its domain, blocks, boxes, emitters and gravity have no z, and its
+// frames are particles and pictures (the surface is a 3D mesh).
+void check_plane(const Scene& scene) {
+    if (scene.params.dimensions != 2) return;
+    const auto off_plane = [&](const std::string& key, Vec3 v) {
+        if (v.z != 0)
+            throw InputError(scene.source + ": " + key + " " + describe_point(v) +
+                             ": a 2D scene lies in the plane z = 0; give [x, y]");
+    };
+    off_plane("domain.min", scene.params.domain_min);
+    off_plane("domain.max", scene.params.domain_max);
+    off_plane("gravity", scene.params.gravity);
+    for (std::size_t i = 0; i < scene.fluid_blocks.size(); ++i) {
+        const std::string key = "fluid_blocks[" + std::to_string(i) + "]";
+        off_plane(key + ".min", scene.fluid_blocks[i].min);
+        off_plane(key + ".max", scene.fluid_blocks[i].max);
+        off_plane(key + ".velocity", scene.fluid_blocks[i].velocity);
+    }
+    for (std::size_t i = 0; i < scene.emitters.size(); ++i) {
+        const std::string key = "emitters[" + std::to_string(i) + "]";
+        off_plane(key + ".center", scene.emitters[i].center);
+        off_plane(key + ".direction", scene.emitters[i].direction);
+    }
+    for (std::size_t i = 0; i < scene.static_boxes.size(); ++i) {
+        const std::string key = "static_boxes[" + std::to_string(i) + "]";
+        off_plane(key + ".min", scene.static_boxes[i].min);
+        off_plane(key + ".max", scene.static_boxes[i].max);
+    }
+    const FrameFormats f = scene.frame_formats();
+    if (f.surface || f.vdb)
+        throw InputError(scene.source + ": output.formats: \"surface\" and \"vdb\" are 3D outputs; a 2D scene "
+                         "writes vtu, ply and preview frames");
+}
+
 // The preview's camera must look somewhere, and temperature colours only what heat conduction gives one.
 void check_preview(const Scene& scene) {
     const Vec3 d = scene.preview.target - scene.preview.eye;
@@ -562,7 +609,7 @@ std::vector<ParamDoc> scene_schema() {
 
 Real Scene::wall_gap() const {
     return rest_density_wall_gap(params.fluid.spacing, params.fluid.support_radius, boundary_spacing(),
-                                 boundary_layers, params.fluid.kernel);
+                                 boundary_layers, params.fluid.kernel, params.dimensions);
 }
 
 std::string Scene::kernel_warning() const {
@@ -631,6 +678,7 @@ Scene resolve_scene(const SceneJson& raw, const std::string& source) {
     }
     read_output(root.object("output"), scene);
     root.finish();
+    check_plane(scene);
     check_surface_voxel(scene);
     check_preview(scene);
     scene.resolved = out;

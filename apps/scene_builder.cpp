@@ -26,13 +26,15 @@
 namespace mw {
 
 namespace {
-double lattice_count(Vec3 lo, Vec3 hi, double spacing) {
-    return std::floor((hi.x - lo.x) / spacing + 1e-4) * std::floor((hi.y - lo.y) / spacing + 1e-4) *
-           std::floor((hi.z - lo.z) / spacing + 1e-4);
+// 2D boxes are rectangles: their lattice is one layer, their surface an outline.
+double lattice_count(Vec3 lo, Vec3 hi, double spacing, int dimensions = 3) {
+    const double layers_z = dimensions == 2 ? 1.0 : std::floor((hi.z - lo.z) / spacing + 1e-4);
+    return std::floor((hi.x - lo.x) / spacing + 1e-4) * std::floor((hi.y - lo.y) / spacing + 1e-4) * layers_z;
 }
-double surface_count(Vec3 lo, Vec3 hi, double spacing, int layers) {
+double surface_count(Vec3 lo, Vec3 hi, double spacing, int layers, int dimensions = 3) {
     const double a = hi.x - lo.x + 2 * layers * spacing, b = hi.y - lo.y + 2 * layers * spacing,
                  c = hi.z - lo.z + 2 * layers * spacing;
+    if (dimensions == 2) return layers * 2 * (a + b) / spacing + 4;
     return layers * 2 * (a * b + b * c + a * c) / (spacing * spacing) + 8;
 }
 void append(SimulationSetup& s, const std::vector<Vec3>& points, Vec3 velocity, std::uint8_t type, std::int32_t object) {
@@ -166,12 +168,15 @@ void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& pl
 ParticleEstimate estimate_particles(const Scene& scene) {
     const double r0 = scene.params.fluid.spacing, rb = scene.boundary_spacing();
     ParticleEstimate n;
-    for (const auto& b : scene.fluid_blocks) n.fluid += lattice_count(b.min, b.max, r0);
+    const int dimensions = scene.params.dimensions;
+    for (const auto& b : scene.fluid_blocks) n.fluid += lattice_count(b.min, b.max, r0, dimensions);
     if (scene.walls())
-        n.boundary += surface_count(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers);
-    for (const auto& b : scene.static_boxes) n.boundary += surface_count(b.min, b.max, rb, b.layers);
+        n.boundary +=
+            surface_count(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers, dimensions);
+    for (const auto& b : scene.static_boxes) n.boundary += surface_count(b.min, b.max, rb, b.layers, dimensions);
     for (const auto& e : scene.emitters) {
-        const double disc = std::max(1.0, M_PI * double(e.radius) * double(e.radius) / (r0 * r0));
+        const double disc = dimensions == 2 ? 2 * std::floor(double(e.radius) / r0) + 1
+                                            : std::max(1.0, M_PI * double(e.radius) * double(e.radius) / (r0 * r0));
         n.fluid += disc * std::ceil((e.end - e.start) * double(e.speed) / r0);
     }
     return n;
@@ -205,7 +210,7 @@ void add_emitters(const Scene& scene, SimulationSetup& setup) {
         EmitterSetup emitter;
         static_cast<EmitterParams&>(emitter) = e;
         emitter.name = e.name;
-        emitter.offsets = disc_lattice(e.direction, e.radius, r0);
+        emitter.offsets = disc_lattice(e.direction, e.radius, r0, scene.params.dimensions);
         emitter.layers = emitter_layers(e, r0);
         emitter.first = static_cast<std::uint32_t>(setup.position.size());
         const double count = double(emitter.layers) * double(emitter.offsets.size());
@@ -234,7 +239,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
     const auto started_at = [&](Real t) { start_new_particles_at(scene, setup, t); };
     for (std::size_t i = 0; i < scene.fluid_blocks.size(); ++i) {
         const FluidBlock& b = scene.fluid_blocks[i];
-        const std::vector<Vec3> points = fill_box_lattice(b.min, b.max, r0);
+        const std::vector<Vec3> points = fill_box_lattice(b.min, b.max, r0, scene.params.dimensions);
         if (points.empty())
             throw InputError(scene.source + ": fluid_blocks[" + std::to_string(i) +
                              "]: the block is thinner than fluid.spacing on some axis and holds no particle");
@@ -249,7 +254,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         // The first layer where fluid blocks touching a wall start at rest density (wall_gap.hpp).
         append(setup,
                sample_container_walls(scene.params.domain_min, scene.params.domain_max, rb, scene.boundary_layers,
-                                      scene.wall_gap()),
+                                      scene.wall_gap(), scene.params.dimensions),
                Vec3{0, 0, 0}, kStaticBoundary, -1);
     started_at(scene.fluid_temperature);  // the walls are adiabatic: their temperature is never read
     const std::size_t first_solid = setup.position.size();
@@ -258,12 +263,13 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         const StaticBox& b = scene.static_boxes[i];
         // Where fluid rests against the box's layers, and the closest the carve below lets it
         // start: the walls' correction sets its band from them (algorithms/wall_contact.hpp).
-        const Real gap =
-            rest_density_wall_gap(r0, scene.params.fluid.support_radius, rb, b.layers, scene.params.fluid.kernel);
+        const Real gap = rest_density_wall_gap(r0, scene.params.fluid.support_radius, rb, b.layers,
+                                               scene.params.fluid.kernel, scene.params.dimensions);
         const Real carved = carved_face_distance(Real(kFluidClearance) * r0, rb);
         setup.params.boundary.static_boxes.push_back(StaticBoxFaces{b.min, b.max, gap, carved});
         // One id space: objects[k] is body k, static_boxes[i] body (objects) + i.
-        append(setup, sample_solid_box(b.min, b.max, rb, b.layers), Vec3{0, 0, 0}, kStaticBoundary,
+        append(setup, sample_solid_box(b.min, b.max, rb, b.layers, scene.params.dimensions), Vec3{0, 0, 0},
+               kStaticBoundary,
                static_cast<std::int32_t>(scene.objects.size() + i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }

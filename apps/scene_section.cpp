@@ -177,11 +177,17 @@ ParamValue Section::convert(const SceneJson& v, const std::string& key, ParamTyp
             return ParamValue::of(text);
         }
         case ParamType::kVector: {
-            if (!v.is_array() || v.size() != 3)
-                fail(p, "expected an array of 3 numbers [x, y, z], got " +
-                            (v.is_array() ? "an array of " + std::to_string(v.size()) : json_type_name(v)));
+            // A 2D scene's vectors are [x, y] (z = 0), or [x, y, z] as its resolved scene writes
+            // them: the preview's camera stands off the plane (check_plane() refuses z elsewhere).
+            const bool flat = resolved_.dimensions == 2;
+            const bool sized = v.is_array() && (v.size() == 3 || (flat && v.size() == 2));
+            if (!sized)
+                fail(p, std::string(flat ? "expected an array of 2 numbers [x, y] (the scene is 2D)"
+                                         : "expected an array of 3 numbers [x, y, z]") +
+                            ", got " + (v.is_array() ? "an array of " + std::to_string(v.size()) : json_type_name(v)));
             ParamValue value = ParamValue::of(Vec3{0, 0, 0});
-            for (int a = 0; a < 3; ++a) value.vector[a] = to_number(v[a], p + "[" + std::to_string(a) + "]");
+            for (std::size_t a = 0; a < v.size(); ++a)
+                value.vector[a] = to_number(v[a], p + "[" + std::to_string(a) + "]");
             return value;
         }
         case ParamType::kTextList: {

@@ -610,7 +610,7 @@ std::array<double, 2> preview_field_range(const PreviewFrame& frame) {
     return widened(*min, *max);
 }
 
-PreviewCamera default_camera(const PreviewVec& domain_lo, const PreviewVec& domain_hi, double aspect) {
+PreviewCamera default_camera(const PreviewVec& domain_lo, const PreviewVec& domain_hi, double aspect, bool head_on) {
     if (!(aspect > 0) || !std::isfinite(aspect)) aspect = 16.0 / 9.0;
     D3 lo = d3(domain_lo), hi = d3(domain_hi);
     const double size = std::max(norm(hi - lo), 1e-6);
@@ -618,7 +618,7 @@ PreviewCamera default_camera(const PreviewVec& domain_lo, const PreviewVec& doma
     camera.fov_y_degrees = 35;
     // 30 degrees round from the front (+z) toward +x and 28 above the horizon: the front, the
     // right-hand side and the floor all show, none edge-on.
-    const double azimuth = 30 * kPi / 180, elevation = 28 * kPi / 180;
+    const double azimuth = head_on ? 0.0 : 30 * kPi / 180, elevation = head_on ? 0.0 : 28 * kPi / 180;
     const D3 toward_eye{std::sin(azimuth) * std::cos(elevation), std::sin(elevation), std::cos(azimuth) * std::cos(elevation)};
     D3 target = 0.5 * (lo + hi);
     const double tan_y = std::tan(0.5 * camera.fov_y_degrees * kPi / 180), tan_x = tan_y * aspect;

@@ -17,14 +17,15 @@ std::string format_length(double x) {
 }
 
 // Σ W over an infinite square grid of `spacing` in a plane at distance `dz`, one grid point
-// straight across. The grid's lateral offset against the fluid changes the first layer's density
+// straight across (in 2D: a row of points on a line). The grid's lateral offset against the fluid changes the first layer's density
 // by less than 1e-4 of ρ0 for spacings up to r0/2 (the default); at a spacing of r0 by up to 0.3%
 // for h = 2 to 2.5 r0 and 2% for h = 1.5 r0.
 template <class Kernel>
 double sheet_sum(const Kernel& kernel, double spacing, double dz) {
     const int reach = static_cast<int>(std::ceil(double(kernel.h) / spacing)) + 1;
+    const int reach_j = Kernel::kDimensions == 3 ? reach : 0;
     double sum = 0;
-    for (int j = -reach; j <= reach; ++j)
+    for (int j = -reach_j; j <= reach_j; ++j)
         for (int i = -reach; i <= reach; ++i) {
             const double r = std::sqrt((i * spacing) * (i * spacing) + (j * spacing) * (j * spacing) + dz * dz);
             sum += kernel.W(Real(r));
@@ -40,8 +41,9 @@ Real wall_gap_for(const Kernel& kernel, double r0, double s, int layers) {
     // The fluid mass makes a full lattice the rest density: ρ0 = m Σ W (ρ0 cancels below, so
     // densities are in units of ρ0 and m = 1 / Σ W).
     double full = 0, half = 0;  // half: the first layer's own half-lattice, r0/2 above the face
+    const int reach_j = Kernel::kDimensions == 3 ? reach : 0;
     for (int k = -reach; k <= reach; ++k)
-        for (int j = -reach; j <= reach; ++j)
+        for (int j = -reach_j; j <= reach_j; ++j)
             for (int i = -reach; i <= reach; ++i) {
                 const double w = kernel.W(Real(r0 * std::sqrt(double(i * i + j * j + k * k))));
                 full += w;
@@ -75,10 +77,10 @@ Real wall_gap_for(const Kernel& kernel, double r0, double s, int layers) {
 }
 }  // namespace
 
-Real rest_density_wall_gap(Real r0, Real h, Real boundary_spacing, int layers, KernelKind kernel) {
+Real rest_density_wall_gap(Real r0, Real h, Real boundary_spacing, int layers, KernelKind kernel, int dimensions) {
     if (!(r0 > 0) || !(h > r0) || !(boundary_spacing > 0) || layers < 1)
         throw InputError("wall gap: need spacing > 0, support radius > spacing, boundary spacing > 0, layers >= 1");
-    return with_kernel(kernel, h, [&](const auto& w) { return wall_gap_for(w, r0, boundary_spacing, layers); });
+    return with_kernel(kernel, dimensions, h, [&](const auto& w) { return wall_gap_for(w, r0, boundary_spacing, layers); });
 }
 
 }  // namespace mw

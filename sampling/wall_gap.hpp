@@ -22,6 +22,6 @@ namespace mw {
 // monotonically as the walls move out; bisection finds where it equals the rest density. Throws
 // InputError if no distance in [0, h + r0] does: not the case for h in (r0, 4 r0] but for h within
 // about 1e-6 of r0, where W(r0) no longer registers in the sums.
-Real rest_density_wall_gap(Real r0, Real h, Real boundary_spacing, int layers, KernelKind kernel);
+Real rest_density_wall_gap(Real r0, Real h, Real boundary_spacing, int layers, KernelKind kernel, int dimensions = 3);
 
 }  // namespace mw

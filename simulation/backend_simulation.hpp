@@ -137,6 +137,9 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup, int t
     const FluidParams& fp = params_.fluid;
     if (!(fp.spacing > 0) || !(fp.support_radius > fp.spacing) || !(fp.rest_density > 0))
         throw InputError("simulation setup: need spacing > 0, support_radius > spacing, rest_density > 0");
+    if (params_.dimensions != Kernel::kDimensions)
+        throw InputError("simulation setup: a " + std::to_string(params_.dimensions) + "D scene given a " +
+                         std::to_string(Kernel::kDimensions) + "D kernel");
     Vec3 lo = params_.domain_min, hi = params_.domain_max;
     const std::vector<std::uint32_t> order = load_particles(setup, lo, hi);
     set_fluid_constants();
@@ -218,9 +221,10 @@ void BackendSimulation<Kernel>::set_fluid_constants() {
     fluid.wall_viscosity = fp.wall_viscosity;
     fluid.gravity = params_.gravity;
     if (params_.boundary.walls && fp.viscosity > 0)
-        fluid.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::kAllFaces, fp.support_radius};
+        fluid.mirrors = WallMirrors{params_.domain_min, params_.domain_max, WallMirrors::faces_in(Kernel::kDimensions),
+                                    fp.support_radius};
     // Mass such that the prototype lattice at spacing r0 has exactly the rest density.
-    const PrototypeSums sums = prototype_sums(fluid.kernel, fp.spacing, 3);
+    const PrototypeSums sums = prototype_sums(fluid.kernel, fp.spacing, Kernel::kDimensions);
     fluid.mass = static_cast<Real>(fp.rest_density / sums.sum_W);
     state_.delta_times_dt2 = pcisph_delta(sums, fp.rest_density, fluid.mass, 1.0);
 }
@@ -401,13 +405,20 @@ void BackendSimulation<Kernel>::load_state(const StateArchive& in) {
     report_.time = time_;
 }
 
-// The simulation for the scene's kernel. The OpenMP backend instantiates each kernel in a source
-// file of its own (simulation/instantiate_openmp*.cpp) so that the two compile in parallel; a step
-// then runs its kernel inline, with no branch on it.
+// The simulation for the scene's kernel and dimensions. The OpenMP backend instantiates each
+// kernel in a source file of its own (simulation/instantiate_openmp*.cpp) so that they compile in
+// parallel; a step then runs its kernel inline, with no branch on it.
 std::unique_ptr<Simulation> make_cubic_spline_simulation(const SimulationSetup& setup, int threads);
 std::unique_ptr<Simulation> make_wendland_c2_simulation(const SimulationSetup& setup, int threads);
+std::unique_ptr<Simulation> make_cubic_spline_2d_simulation(const SimulationSetup& setup, int threads);
+std::unique_ptr<Simulation> make_wendland_c2_2d_simulation(const SimulationSetup& setup, int threads);
 inline std::unique_ptr<Simulation> make_simulation(const SimulationSetup& setup, int threads) {
-    if (setup.params.fluid.kernel == KernelKind::kWendlandC2) return make_wendland_c2_simulation(setup, threads);
+    const bool wendland = setup.params.fluid.kernel == KernelKind::kWendlandC2;
+    if (setup.params.dimensions == 2)
+        return wendland ? make_wendland_c2_2d_simulation(setup, threads) : make_cubic_spline_2d_simulation(setup, threads);
+    if (setup.params.dimensions != 3)
+        throw InputError("simulation setup: dimensions must be 2 or 3, got " + std::to_string(setup.params.dimensions));
+    if (wendland) return make_wendland_c2_simulation(setup, threads);
     return make_cubic_spline_simulation(setup, threads);
 }
 

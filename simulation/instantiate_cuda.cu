@@ -1,6 +1,6 @@
-// The CUDA instantiation of the simulation, for both kernels, and the backend's factory.
+// The CUDA instantiation of the simulation, for both kernels in 2D and 3D, and the backend's factory.
 //
-// Both kernels are instantiated in this one translation unit, unlike OpenMP's two files. nvcc
+// All four are instantiated in this one translation unit, unlike OpenMP's two files. nvcc
 // gives each translation unit its own copy (in an anonymous namespace) of the function pointers
 // behind an extended __host__ __device__ lambda, and a lambda written in a non-template function
 // (build_slot_map, fill_cell_ranges, ...) has the same type in every unit, so the linker keeps one
@@ -37,5 +37,11 @@ std::unique_ptr<Simulation> make_cubic_spline_simulation(const SimulationSetup& 
 }
 std::unique_ptr<Simulation> make_wendland_c2_simulation(const SimulationSetup& setup, int threads) {
     return std::make_unique<BackendSimulation<WendlandC2_3D>>(setup, threads);
+}
+std::unique_ptr<Simulation> make_cubic_spline_2d_simulation(const SimulationSetup& setup, int threads) {
+    return std::make_unique<BackendSimulation<CubicSpline2D>>(setup, threads);
+}
+std::unique_ptr<Simulation> make_wendland_c2_2d_simulation(const SimulationSetup& setup, int threads) {
+    return std::make_unique<BackendSimulation<WendlandC2_2D>>(setup, threads);
 }
 MW_BACKEND_END

@@ -104,6 +104,7 @@ struct ParamRange {
 // scene gave them (a Real member would round them).
 struct ResolvedKeys {
     std::map<std::string, ParamValue> values;
+    int dimensions = 3;  // the scene's: a 2D scene's vectors are [x, y] (z = 0)
     const ParamValue* find(const std::string& path) const {
         auto it = values.find(path);
         return it == values.end() ? nullptr : &it->second;

@@ -29,6 +29,9 @@ namespace mw {
 // Each struct's member defaults are the scenes' defaults (their tables say so: `meltwater
 // schema`), but for the geometry the scene builder fills in.
 struct SimulationParams {
+    // 3, or 2: every particle in the plane z = 0, the kernels normalised in 2D, walls on the four
+    // faces normal to x and y only (the domain's z extent is [0, 0]).
+    int dimensions = 3;
     Vec3 domain_min{0, 0, 0};
     Vec3 domain_max{1, 1, 1};
     Vec3 gravity{0, -9.81f, 0};

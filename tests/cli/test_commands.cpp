@@ -44,7 +44,7 @@ TEST_CASE("bad input: scene keys and values") {
     check_rejected(run("info " + tiny() + " --set fluid.spacing=abc"), {"fluid.spacing", "expected a number"});
     check_rejected(run("info " + tiny() + " --set fluid.spacing=-0.01"), {"fluid.spacing", "> 0"});
     check_rejected(run("info " + tiny() + " --set boundary.layers=2.5"), {"boundary.layers", "integer"});
-    check_rejected(run("info " + tiny() + " --set dimensions=2"), {"dimensions"});
+    check_rejected(run("info " + tiny() + " --set dimensions=4"), {"dimensions", "2 or 3"});
     check_rejected(run("info " + tiny() + " --set 'fluid_blocks.0.max=[5,5,5]'"), {"fluid_blocks[0]", "domain"});
     check_rejected(run("info " + tiny() + " --set solver.dt_mode=sometimes"), {"solver.dt_mode", "sometimes"});
     check_rejected(run("info " + tiny() + " --set nokey"), {"--set nokey", "KEY=VALUE"});

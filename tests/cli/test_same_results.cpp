@@ -77,7 +77,7 @@ void check_scene(const std::string& name) {
 }  // namespace
 
 TEST_CASE("same results: the fluid-only scenes") {
-    for (const char* name : {"dam_break", "dam_break_cylinder", "dam_break_paper_kernel", "hydrostatic_column",
+    for (const char* name : {"dam_break", "dam_break_2d", "dam_break_cylinder", "dam_break_paper_kernel", "hydrostatic_column",
                              "splishsplash_block"}) {
         const std::string scene_name = name;
         CAPTURE(scene_name);

@@ -41,6 +41,17 @@ const char* kTank = R"({
   "run": { "end_time": 2.0 }
 })";
 
+// The same tap in a 2D tank 0.4 m wide: its disc a segment of 5 points across the plane.
+const char* kTank2D = R"({
+  "dimensions": 2,
+  "domain": { "min": [0, 0], "max": [0.4, 0.6] },
+  "fluid": { "spacing": 0.02, "support_radius": 0.04, "viscosity": 0.01 },
+  "solver": { "dt": 0.004, "dt_mode": "cfl" },
+  "emitters": [ { "name": "tap", "center": [0.2, 0.5], "direction": [0, -1], "radius": 0.05,
+                  "speed": 1.5, "end": 1.0 } ],
+  "run": { "end_time": 2.0 }
+})";
+
 }  // namespace
 
 TEST_CASE("an emitter releases a layer every r0 / speed, each where and as fast as its release time says") {
@@ -114,6 +125,36 @@ TEST_CASE("a stream fills a tank to the height of the volume it released") {
                            << sim->last_report().max_speed << " m/s");
     CHECK(mean_height == doctest::Approx(depth / 2).epsilon(0.05));
     CHECK(sim->last_report().max_speed < 1.0);  // settling
+}
+
+// In 2D each particle is a lattice cell r0² per metre of depth: 75 layers of 5 particles fill
+// 0.15 m² of the 0.4 m wide tank, 0.375 m deep.
+TEST_CASE("2D: a stream fills a tank to the height of the area it released") {
+    const SimulationSetup setup = setup_of(kTank2D);
+    REQUIRE(setup.emitters.size() == 1);
+    for (const Vec3& o : setup.emitters[0].offsets) CHECK(o.z == 0);
+    const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+    const long released = long(setup.emitters[0].layers * setup.emitters[0].offsets.size());
+    REQUIRE(released == 375);
+    while (sim->time() < 2.0) sim->step();
+    CHECK(sim->last_report().value("emitted") == released);
+    CHECK(sim->last_report().lost_particles == 0);
+    HostParticles p;
+    sim->download(p);
+    double mean_height = 0, largest_z = 0;
+    long fluid = 0;
+    for (std::size_t i = 0; i < p.type.size(); ++i) {
+        largest_z = std::max(largest_z, std::fabs(double(p.position[i].z)));
+        if (p.type[i] == kFluid) mean_height += double(p.position[i].y), ++fluid;
+    }
+    REQUIRE(fluid == released);
+    mean_height /= double(fluid);
+    const double depth = double(released) * 0.02 * 0.02 / 0.4;
+    MESSAGE("2D: mean height " << mean_height << " m against " << depth / 2 << "; top speed at the end "
+                               << sim->last_report().max_speed << " m/s");
+    CHECK(largest_z == 0);
+    CHECK(mean_height == doctest::Approx(depth / 2).epsilon(0.05));
+    CHECK(sim->last_report().max_speed < 1.0);
 }
 
 TEST_CASE("a level jet keeps its speed in open air: the nozzle holds its newest layers on their paths") {

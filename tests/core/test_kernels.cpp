@@ -29,17 +29,35 @@ TEST_CASE_TEMPLATE("the 3D kernels integrate to one", Kernel, CubicSpline3D, Wen
     CHECK(integral == doctest::Approx(1.0).epsilon(2e-3));
 }
 
-TEST_CASE("cubic spline 2D integrates to one") {
+TEST_CASE_TEMPLATE("the 2D kernels integrate to one", Kernel, CubicSpline2D, WendlandC2_2D) {
     const double h = 0.1, step = h / 200;
-    const CubicSpline2D kernel = CubicSpline2D::with_support(Real(h));
+    const Kernel kernel = Kernel::with_support(Real(h));
     double integral = 0;
     for (double x = -h; x <= h; x += step)
         for (double y = -h; y <= h; y += step) integral += kernel.W(Real(std::sqrt(x * x + y * y))) * step * step;
     CHECK(integral == doctest::Approx(1.0).epsilon(2e-3));
 }
 
+// Müller's viscosity Laplacian, normalised in the kernel's dimensions: the continuum sum
+// ∫ (v(x + r) - v(x)) ∇²W(r) dV for v = y² is the field's Laplacian, 2, when the constant is
+// 45/(π h⁶) in 3D and 40/(π h⁵) in 2D. In polar (2D) or spherical (3D) shells, with y² averaging
+// to r²/D over a shell.
+TEST_CASE_TEMPLATE("the viscosity Laplacian recovers the Laplacian of y squared in its dimensions", Kernel,
+                   CubicSpline3D, WendlandC2_3D, CubicSpline2D, WendlandC2_2D) {
+    const double h = 0.1;
+    const Kernel kernel = Kernel::with_support(Real(h));
+    const int n = 20000;
+    double integral = 0;
+    for (int k = 0; k < n; ++k) {
+        const double r = (k + 0.5) * h / n;
+        const double shell = Kernel::kDimensions == 3 ? 4 * kPi * r * r : 2 * kPi * r;
+        integral += r * r / Kernel::kDimensions * kernel.laplacian_visc(Real(r)) * shell * (h / n);
+    }
+    CHECK(integral == doctest::Approx(2.0).epsilon(1e-3));
+}
+
 TEST_CASE_TEMPLATE("kernel gradient is antisymmetric, points inward and matches finite differences", Kernel,
-                   CubicSpline3D, WendlandC2_3D) {
+                   CubicSpline3D, WendlandC2_3D, CubicSpline2D, WendlandC2_2D) {
     const Kernel kernel = Kernel::with_support(Real(0.1));
     const Vec3 samples[] = {{0.01f, 0.02f, -0.03f}, {0.04f, 0.0f, 0.01f}, {-0.06f, 0.05f, 0.02f}, {0.0f, 0.0f, 0.09f}};
     for (Vec3 r : samples) {
@@ -58,7 +76,7 @@ TEST_CASE_TEMPLATE("kernel gradient is antisymmetric, points inward and matches 
 }
 
 TEST_CASE_TEMPLATE("the branch-free forms of W, grad W and the viscosity Laplacian equal them, and vanish out of range",
-                   Kernel, CubicSpline3D, WendlandC2_3D) {
+                   Kernel, CubicSpline3D, WendlandC2_3D, CubicSpline2D, WendlandC2_2D) {
     const Real h = Real(0.1);
     const Kernel kernel = Kernel::with_support(h);
     double worst_w = 0, worst_grad = 0, worst_laplacian = 0;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "simulation/simulation.hpp"
+#include "algorithms/pcisph_delta.hpp"
 #include "algorithms/state_archive.hpp"
 #include "algorithms/sph_kernels.hpp"
 #include "apps/scene_builder.hpp"
@@ -37,10 +38,13 @@ struct OneHostThread {
 // A box of fluid [block_lo, block_hi] in a domain [lo, hi] lined with Akinci walls at spacing r0/2,
 // the first layer rest_density_wall_gap() outside the faces (the fluid starts at rest density);
 // `walls` false leaves the domain open. The kernel is `kernel` with support radius `support_in_r0` r0.
+// In 2D (`dimensions` 2) the boxes are rectangles in the plane z = 0 (their z is ignored).
 inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_hi, Real r0, Real dt,
                                     bool walls = true, Real support_in_r0 = 2,
-                                    KernelKind kernel = KernelKind::kCubicSpline) {
+                                    KernelKind kernel = KernelKind::kCubicSpline, int dimensions = 3) {
     SimulationSetup setup;
+    if (dimensions == 2) lo.z = hi.z = block_lo.z = block_hi.z = 0;
+    setup.params.dimensions = dimensions;
     setup.params.domain_min = lo;
     setup.params.domain_max = hi;
     setup.params.fluid.spacing = r0;
@@ -48,16 +52,16 @@ inline SimulationSetup fluid_in_box(Vec3 lo, Vec3 hi, Vec3 block_lo, Vec3 block_
     setup.params.fluid.kernel = kernel;
     setup.params.fluid.rest_density = 1000;
     setup.params.solver.dt = dt;
-    for (const Vec3& p : fill_box_lattice(block_lo, block_hi, r0)) {
+    for (const Vec3& p : fill_box_lattice(block_lo, block_hi, r0, dimensions)) {
         setup.position.push_back(p);
         setup.type.push_back(kFluid);
     }
     setup.params.boundary.walls = walls;
     if (walls) {
-        const Real gap = rest_density_wall_gap(r0, setup.params.fluid.support_radius, r0 / 2, 1, kernel);
+        const Real gap = rest_density_wall_gap(r0, setup.params.fluid.support_radius, r0 / 2, 1, kernel, dimensions);
         setup.params.boundary.wall_gap = gap;
         setup.params.boundary.correction = true;  // as the shipped scenes run (boundary.correction)
-        for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, gap)) {
+        for (const Vec3& p : sample_container_walls(lo, hi, r0 / 2, 1, gap, dimensions)) {
             setup.position.push_back(p);
             setup.type.push_back(kStaticBoundary);
         }
@@ -229,8 +233,8 @@ std::vector<double> akinci_volumes(const std::vector<Vec3>& boundary, const Poin
 // Adds each fluid particle's SPH-smoothed pressure, Σ_j W_ij p_j/ρ_j / Σ_j W_ij/ρ_j over fluid j,
 // to smoothed_sum[i] (indexed like p). PCISPH's raw per-particle pressure carries the step's
 // correction impulse (a scatter of about 10% of ρ0 g H); the smoothed field is what it gets right.
-inline void add_smoothed_pressure(const HostParticles& p, const CubicSpline3D& kernel,
-                                  std::vector<double>& smoothed_sum) {
+template <class Kernel>
+void add_smoothed_pressure(const HostParticles& p, const Kernel& kernel, std::vector<double>& smoothed_sum) {
     std::vector<Vec3> fluid;
     std::vector<std::size_t> index;  // index in p of each entry of `fluid`
     for (std::size_t i = 0; i < p.position.size(); ++i)
@@ -249,21 +253,18 @@ inline void add_smoothed_pressure(const HostParticles& p, const CubicSpline3D& k
     }
 }
 
-// A settled column's pressure against p(y) = ρ0 g (top - y) over [bottom, top]: the smoothed
+// A settled column's pressure against an expected profile p(y) over [bottom, top]: the smoothed
 // pressure averaged over `averaged` steps (smoothed_sum / averaged) for the fluid particles whose
 // position averaged over the same steps (mean_position) is inside `interior`, as a deviation
-// relative to ρ0 g (top - bottom), averaged per layer r0 thick. `top` is the column's height
-// averaged over those steps too: a column still settling can move particles by up to r0 within
-// the window, so comparing the window's pressure with the last step's heights would measure the
-// motion, not the profile.
+// relative to `scale` (the expected pressure at the bottom), averaged per layer r0 thick.
 struct HydrostaticProfile {
     double worst_layer = 0, worst_particle = 0;
     std::size_t layers = 0;
 };
 inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std::vector<double>& smoothed_sum,
-                                              const std::vector<Vec3>& mean_position, int averaged, double rho_g,
-                                              double bottom, double top, double r0, Vec3 interior_lo,
-                                              Vec3 interior_hi) {
+                                              const std::vector<Vec3>& mean_position, int averaged,
+                                              const std::function<double(double)>& expected, double scale,
+                                              double bottom, double r0, Vec3 interior_lo, Vec3 interior_hi) {
     std::map<int, std::pair<double, int>> layers;  // layer -> (sum of relative deviation, count)
     HydrostaticProfile out;
     for (std::size_t i = 0; i < p.position.size(); ++i) {
@@ -271,7 +272,7 @@ inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std:
         if (p.type[i] != kFluid || x.x < interior_lo.x || x.x > interior_hi.x || x.y < interior_lo.y ||
             x.y > interior_hi.y || x.z < interior_lo.z || x.z > interior_hi.z)
             continue;
-        const double deviation = (smoothed_sum[i] / averaged - rho_g * (top - x.y)) / (rho_g * (top - bottom));
+        const double deviation = (smoothed_sum[i] / averaged - expected(x.y)) / scale;
         out.worst_particle = std::max(out.worst_particle, std::fabs(deviation));
         auto& layer = layers[int((x.y - bottom) / r0)];
         layer.first += deviation;
@@ -286,13 +287,19 @@ inline HydrostaticProfile hydrostatic_profile(const HostParticles& p, const std:
 // square from x = z = 0, its fluid standing on `bottom`) is stepped `steps` times; over the last
 // `averaged` steps the largest reported mean density error is kept, and the smoothed pressure
 // (add_smoothed_pressure), each particle's position and the column's height H (the highest fluid
-// centre + r0/2) are averaged; then the hydrostatic_profile against ρ0 g (H - y) over the
-// interior: 2 h clear of the side walls, of `bottom` and of the surface, where the free surface and
-// the walls' truncated kernel sums do not reach.
+// centre + r0/2) are averaged; then the hydrostatic_profile over the interior (2 h clear of the
+// side walls, of `bottom` and of the surface, where the free surface and the walls' truncated
+// kernel sums do not reach) against two references:
+//  - ρ0 g (H - y), with H the settled height: `profile`;
+//  - the weight of the fluid above y per unit area (per unit width in 2D), g m Σ_j f_j(y) / A,
+//    f_j the part of particle j's cell (r0 tall, centred on its mean height) above y: `by_weight`.
+//    Static equilibrium, whatever the density: the fluid PCISPH leaves compressed by up to η
+//    weighs the same but stands lower, so ρ0 g (H - y) falls short of it by about η ρ0 g H at the
+//    bottom.
 struct SettledColumn {
     HostParticles particles;  // after the last step
     double worst_avg_error = 0, H = 0;  // H: averaged over the last steps
-    HydrostaticProfile profile;
+    HydrostaticProfile profile, by_weight;
 };
 // `on_step(step, report, particles)` runs after every step with its report; `particles` is the
 // download made on the averaged steps, and on every `download_every`th step before them (0: none),
@@ -301,7 +308,6 @@ using OnSettleStep = std::function<void(int step, const StepReport& report, cons
 inline SettledColumn settle_column(Simulation& sim, const SimulationParams& params, int steps, int averaged,
                                    double bottom, Real width, int download_every, const OnSettleStep& on_step) {
     const Real r0 = params.fluid.spacing;
-    const CubicSpline3D kernel = CubicSpline3D::with_support(params.fluid.support_radius);
     SettledColumn out;
     std::vector<double> smoothed_sum;
     std::vector<double> position_sum;  // x, y, z of each particle, summed over the averaged steps
@@ -314,7 +320,8 @@ inline SettledColumn settle_column(Simulation& sim, const SimulationParams& para
         if (on_step) on_step(step, sim.last_report(), download ? &out.particles : nullptr);
         if (!in_average) continue;
         out.worst_avg_error = std::max(out.worst_avg_error, sim.last_report().density_error_avg);
-        add_smoothed_pressure(out.particles, kernel, smoothed_sum);
+        with_kernel(KernelKind::kCubicSpline, params.dimensions, params.fluid.support_radius,
+                    [&](const auto& kernel) { add_smoothed_pressure(out.particles, kernel, smoothed_sum); });
         const HostParticles& p = out.particles;
         position_sum.resize(3 * p.position.size(), 0.0);
         double top = 0;
@@ -334,9 +341,29 @@ inline SettledColumn settle_column(Simulation& sim, const SimulationParams& para
     out.H = top_sum / averaged + r0 / 2;
     const double rho_g = double(params.fluid.rest_density) * -double(params.gravity.y),
                  margin = 2 * double(params.fluid.support_radius);
-    out.profile = hydrostatic_profile(p, smoothed_sum, mean_position, averaged, rho_g, bottom, out.H, r0,
-                                      Vec3{Real(margin), Real(bottom + margin), Real(margin)},
-                                      Vec3{Real(width - margin), Real(out.H - margin), Real(width - margin)});
+    // In 2D the column is the plane z = 0.
+    const Real z_lo = params.dimensions == 2 ? Real(0) : Real(margin);
+    const Real z_hi = params.dimensions == 2 ? Real(0) : Real(width - margin);
+    const Vec3 interior_lo{Real(margin), Real(bottom + margin), z_lo};
+    const Vec3 interior_hi{Real(width - margin), Real(out.H - margin), z_hi};
+    const double H = out.H;
+    out.profile = hydrostatic_profile(
+        p, smoothed_sum, mean_position, averaged, [&](double y) { return rho_g * (H - y); }, rho_g * (H - bottom),
+        bottom, r0, interior_lo, interior_hi);
+    const double mass = with_kernel(KernelKind::kCubicSpline, params.dimensions, params.fluid.support_radius,
+                                    [&](const auto& kernel) {
+                                        return double(params.fluid.rest_density) /
+                                               prototype_sums(kernel, r0, params.dimensions).sum_W;
+                                    });
+    const double area = params.dimensions == 2 ? double(width) : double(width) * width;
+    const auto weight_above = [&](double y) {
+        double cells = 0;
+        for (std::size_t j = 0; j < p.position.size(); ++j)
+            if (p.type[j] == kFluid) cells += std::clamp((mean_position[j].y + r0 / 2 - y) / r0, 0.0, 1.0);
+        return -double(params.gravity.y) * mass * cells / area;
+    };
+    out.by_weight = hydrostatic_profile(p, smoothed_sum, mean_position, averaged, weight_above, weight_above(bottom),
+                                        bottom, r0, interior_lo, interior_hi);
     return out;
 }
 

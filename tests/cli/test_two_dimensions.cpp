@@ -1,0 +1,81 @@
+// 2D scenes from the command line: `dimensions: 2` runs fluid in the plane z = 0 (the physics is
+// checked in tests/core: test_hydrostatic.cpp, test_dam_break.cpp, test_two_dimensions.cpp), its
+// frames hold z = 0 and
+// its pictures look at the plane head-on; what 2D scenes cannot hold yet is refused in one line.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+
+#include "apps/vtu_reader.hpp"
+#include "cli_helpers.hpp"
+
+using namespace cli_test;
+namespace fs = std::filesystem;
+
+namespace {
+// A 2D dam break 0.4 x 0.3 m: a 0.1 x 0.2 m column (10 x 20 particles), with `extra` spliced in.
+std::string tiny_2d_text(const std::string& extra = "") {
+    return std::string(R"({
+  "name": "tiny_2d",
+  "dimensions": 2,
+  "domain": { "min": [0, 0], "max": [0.4, 0.3] },
+  "fluid": { "spacing": 0.01 },
+  "solver": { "dt": 0.002, "dt_mode": "cfl" },
+  "fluid_blocks": [ { "min": [0, 0], "max": [0.1, 0.2] } ])") +
+           (extra.empty() ? "" : ",\n  " + extra) + "\n}\n";
+}
+}  // namespace
+
+TEST_CASE("2D scene: the frames hold the plane z = 0 and the picture looks at it head-on") {
+    const std::string scene = scene_file("tiny_2d.json", tiny_2d_text());
+    const std::string dir = out_dir("tiny_2d_run");
+    const Result r = run("run " + scene + " --time 0.1 --quiet --checkpoint --out " + dir +
+                         " --set output.fps=10 --set 'output.formats=[\"vtu\",\"preview\"]'");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    const auto summary = read_json(dir + "/summary.json");
+    CHECK(summary["particles"]["fluid"] == 200);
+    CHECK(summary["lost_particles"] == 0);
+    CHECK(summary["scene"]["dimensions"] == 2);
+    const mw::VtuFrame frame = mw::read_vtu(dir + "/frames/particles_00001.vtu");
+    REQUIRE(frame.points.size() == 200);
+    double largest_z = 0, lowest_top = 1;
+    for (const mw::Vec3& x : frame.points) largest_z = std::max(largest_z, std::fabs(double(x.z)));
+    for (const mw::Vec3& x : frame.points) lowest_top = std::min(lowest_top, double(x.y));
+    CHECK(largest_z == 0);
+    CHECK(lowest_top > 0);  // above the floor's layer
+    CHECK(fs::exists(dir + "/frames/preview_00001.png"));
+    // Head-on: the camera stands in front of the domain's middle.
+    const auto eye = summary["scene"]["output"]["preview"]["eye"];
+    CHECK(eye[0].get<double>() == doctest::Approx(0.2));
+    CHECK(eye[1].get<double>() == doctest::Approx(0.15));
+    CHECK(eye[2].get<double>() > 0.3);
+    // The resolved scene (camera off the plane included) reads back: a 2D run resumes.
+    const Result resumed = run("run --resume " + dir + "/checkpoint.mwc --time 0.14 --quiet");
+    CAPTURE(resumed.err);
+    CHECK(resumed.code == 0);
+}
+
+TEST_CASE("2D scene: what it cannot hold yet, and points off the plane, are refused in one line") {
+    struct Case {
+        const char* name;
+        std::string extra;
+        std::vector<std::string> parts;
+    };
+    const std::vector<Case> cases = {
+        {"objects", R"("objects": [{}])", {"objects", "not available in 2D"}},
+        {"static box off the plane", R"("static_boxes": [{ "min": [0.2, 0, 0], "max": [0.3, 0.1, 0.1] }])",
+         {"static_boxes[0].max", "plane z = 0"}},
+        {"emitter off the plane", R"("emitters": [{ "center": [0.2, 0.25, 0.1], "direction": [0, -1, 0], "radius": 0.02, "speed": 1 }])",
+         {"emitters[0].center", "plane z = 0"}},
+        {"pressure sensors", R"("pressure_sensors": [{}])", {"pressure_sensors", "not available in 2D"}},
+        {"surface frames", R"("output": { "formats": ["surface"] })", {"output.formats", "3D outputs"}},
+        {"gravity off the plane", R"("gravity": [0, -9.81, 1])", {"gravity", "plane z = 0"}},
+        {"vector of 4", R"("gravity": [0, -9.81, 0, 0])", {"gravity", "2 numbers [x, y]"}},
+    };
+    for (const Case& c : cases) {
+        const std::string name = c.name;
+        CAPTURE(name);
+        check_rejected(run("info " + scene_file("refused_2d.json", tiny_2d_text(c.extra))), c.parts);
+    }
+}

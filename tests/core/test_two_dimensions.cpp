@@ -1,0 +1,84 @@
+// What is particular to the plane: a 2D scene's boundaries have no faces normal to z. A 2D dam
+// break strikes a static box standing on the floor (its outline sampled as in 3D); the walls' and
+// the box's velocity–position correction must hold the fluid at its band in the plane without
+// ever pushing a particle off it. (The fluid alone in 2D: test_hydrostatic.cpp, test_dam_break.cpp.)
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "algorithms/wall_contact.hpp"
+#include "apps/scene.hpp"
+#include "apps/scene_builder.hpp"
+#include "simulation/factory.hpp"
+
+using namespace mw;
+
+namespace {
+// A 0.4 x 0.8 m column at r0 0.02 m collapsing onto a 0.2 m square box 0.5 m downstream, CFL steps
+// as the scenes run them.
+std::string dam_against_box(bool correction) {
+    return std::string(R"({
+  "name": "dam_box_2d",
+  "dimensions": 2,
+  "domain": { "min": [0, 0], "max": [1.6, 1.0] },
+  "fluid": { "spacing": 0.02 },
+  "solver": { "dt": 0.002, "dt_mode": "cfl" },
+  "boundary": { "correction": )") +
+           (correction ? "true" : "false") + R"( },
+  "fluid_blocks": [ { "min": [0, 0], "max": [0.4, 0.8] } ],
+  "static_boxes": [ { "min": [0.9, 0], "max": [1.1, 0.2] } ]
+})";
+}
+
+struct BoxRun {
+    double closest = 1e9;  // the closest fluid centre came to the box, m
+    double largest_z = 0;
+    long inside = 0, lost = 0;
+};
+
+BoxRun run_against_box(bool correction, double seconds) {
+    const SimulationSetup setup = build_setup(parse_scene_text(dam_against_box(correction), "dam_box_2d.json"));
+    auto sim = create_openmp_simulation(setup, 1);
+    BoxRun out;
+    HostParticles p;
+    while (sim->time() < seconds) {
+        sim->step();
+        sim->download(p);
+        for (std::size_t i = 0; i < p.position.size(); ++i) {
+            out.largest_z = std::max(out.largest_z, std::fabs(double(p.position[i].z)));
+            if (p.type[i] != kFluid) continue;
+            const double x = p.position[i].x, y = p.position[i].y;
+            const double dx = x - std::clamp(x, 0.9, 1.1), dy = y - std::clamp(y, 0.0, 0.2);
+            out.closest = std::min(out.closest, std::sqrt(dx * dx + dy * dy));
+            out.inside += dx == 0 && dy == 0;
+        }
+        out.lost = std::max(out.lost, sim->last_report().lost_particles);
+    }
+    return out;
+}
+}  // namespace
+
+TEST_CASE("2D: a dam break against a static box keeps its fluid at the box's band and in the plane") {
+    const double r0 = 0.02;
+    const SimulationSetup setup = build_setup(parse_scene_text(dam_against_box(true), "dam_box_2d.json"));
+    REQUIRE(setup.params.boundary.static_boxes.size() == 1);
+    const double band = contact_box(setup.params.boundary.static_boxes[0], Real(r0), 2).contact;
+    const BoxRun with = run_against_box(true, 1.5);
+    const BoxRun without = run_against_box(false, 1.5);
+    MESSAGE("closest fluid centre to the box: " << with.closest / r0 << " r0 with the correction (band "
+                                                << band / r0 << " r0), " << without.closest / r0 << " r0 without");
+    CHECK(with.inside == 0);
+    CHECK(without.inside == 0);
+    CHECK(with.lost == 0);
+    CHECK(without.lost == 0);
+    CHECK(with.largest_z == 0);
+    CHECK(without.largest_z == 0);
+    // The correction puts fluid moving into the box back at its band; a particle inside the band
+    // that is leaving it is left where it is, so the band holds to within 10% (measured 0.922 r0
+    // for a band of 0.935 r0). Without it the Akinci layer alone lets the surge come closer
+    // (measured 0.606 r0).
+    CHECK(with.closest > 0.9 * band);
+    CHECK(without.closest < 0.9 * band);
+}
