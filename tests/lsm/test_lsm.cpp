@@ -130,6 +130,30 @@ TEST_CASE("polar decomposition: rotation of R·S, flat and line-like matrices, i
     CHECK(q.z == 0);
 }
 
+// A 2D region's A_pq has no z row or column. Its rotation is the in-plane angle: from the identity,
+// ω = Σ_k r_k × a_k lies along z exactly while the a_k lie in the plane, so the iteration turns
+// about z only and never tilts out of the plane (what shape matching in a 2D scene would need).
+TEST_CASE("polar decomposition of a planar matrix: a rotation about z by its angle, exactly in the plane") {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int trial = 0; trial < 100; ++trial) {
+        const double angle = 1.2 * u(rng);
+        // A symmetric positive 2 x 2 stretch, embedded with z's row and column zero.
+        const double a = 1 + 0.5 * u(rng), b = 1 + 0.5 * u(rng), c = 0.3 * u(rng);
+        const double cs = std::cos(angle), sn = std::sin(angle);
+        Mat3 A = mat3_zero();
+        A.m[0][0] = Real(cs * a - sn * c), A.m[0][1] = Real(cs * c - sn * b);
+        A.m[1][0] = Real(sn * a + cs * c), A.m[1][1] = Real(sn * c + cs * b);
+        const Quat q = polar_rotation(A, quat_identity(), 100);
+        CAPTURE(angle);
+        CHECK(q.x == 0);
+        CHECK(q.y == 0);
+        const Mat3 R = quat_to_mat3(q);  // q and -q are one rotation: its angle from R
+        CHECK(std::atan2(double(R.m[1][0]), double(R.m[0][0])) == doctest::Approx(angle).epsilon(1e-4));
+        CHECK(R.m[2][2] == doctest::Approx(1.0).epsilon(1e-6));
+    }
+}
+
 TEST_CASE("a body at rest with no forces stays at rest for 1000 steps") {
     SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, Real(0.01), Vec3{0, 0, 0});
     add(s, box_mesh(Vec3{0.16f, 0.1f, 0.12f}, Vec3{0.5f, 0.5f, 0.5f}, Vec3{10, 20, 30}), solid(SolidKind::kElastic, 1000, 2, 0.5f, 1));
