@@ -87,15 +87,19 @@ struct StaticBoxFaces {
     Real carve_distance = 0;
 };
 
+// In 2D a box [lo, hi] is a rectangle in the plane: it has no face normal to z, so its extent
+// along z is made unbounded (every test on z then passes).
+inline void open_along_z_in_2d(Vec3& lo, Vec3& hi, int dimensions) {
+    if (dimensions != 2) return;
+    lo.z = -std::numeric_limits<Real>::infinity();
+    hi.z = std::numeric_limits<Real>::infinity();
+}
+
 // The band of a static box: as a wall's, and no wider than the carve lets fluid start.
-// In 2D the box is a rectangle in the plane, unbounded along z (no face normal to z).
 inline ContactBox contact_box(const StaticBoxFaces& box, Real r0, int dimensions = 3) {
     const Real band = contact_distance(box.layer_gap, r0);
     ContactBox c{box.lo, box.hi, band < box.carve_distance ? band : box.carve_distance};
-    if (dimensions == 2) {
-        c.lo.z = -std::numeric_limits<Real>::infinity();
-        c.hi.z = std::numeric_limits<Real>::infinity();
-    }
+    open_along_z_in_2d(c.lo, c.hi, dimensions);
     return c;
 }
 
@@ -134,17 +138,13 @@ struct WallContact {
     View<const Real> object_distances;  // every object's grid values, one after another
 
     // For a domain [domain_lo, domain_hi] whose walls' first layer lies `gap` outside the faces.
-    // A 2D domain has no walls normal to z: its band there is unbounded.
     static WallContact for_domain(Vec3 domain_lo, Vec3 domain_hi, Real gap, Real r0, int dimensions = 3) {
         const Real contact = contact_distance(gap, r0);
         const Real inward = contact - gap;  // from the face into the domain (negative: outside it)
         WallContact c;
         c.lo = Vec3{domain_lo.x + inward, domain_lo.y + inward, domain_lo.z + inward};
         c.hi = Vec3{domain_hi.x - inward, domain_hi.y - inward, domain_hi.z - inward};
-        if (dimensions == 2) {
-            c.lo.z = -std::numeric_limits<Real>::infinity();
-            c.hi.z = std::numeric_limits<Real>::infinity();
-        }
+        open_along_z_in_2d(c.lo, c.hi, dimensions);
         return c;
     }
 

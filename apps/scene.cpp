@@ -284,11 +284,12 @@ void read_root(Section& root, Scene& scene) {
     }
     root.resolved().dimensions = scene.params.dimensions;
     root.record("dimensions", scene.params.dimensions);
-    // What 2D scenes hold so far: fluid blocks in a walled domain.
+    // What 2D scenes do not hold yet (the resolved scene writes them as empty arrays).
     if (scene.params.dimensions == 2)
         for (const char* key : {"objects", "pressure_sensors"})
             if (const SceneJson* v = root.find(key); v && !(v->is_array() && v->empty()))
-                root.fail(key, "not available in 2D scenes yet (they take fluid_blocks, static_boxes, emitters and the domain walls)");
+                root.fail(key, "not available in 2D scenes yet (they take fluid_blocks, static_boxes, emitters "
+                               "and the domain walls)");
     root.read(scene_keys(), scene);
     // The name becomes the default output directory results/<name>: no path separators or dots
     // that would lead elsewhere, nothing a shell or a terminal would mangle.
@@ -517,8 +518,8 @@ void check_surface_voxel(const Scene& scene) {
     }
 }
 
-// A 2D scene lies in the plane z = 0: its domain, blocks, boxes, emitters and gravity have no z, and its
-// frames are particles and pictures (the surface is a 3D mesh).
+// A 2D scene lies in the plane z = 0: its domain, blocks, boxes, emitters and gravity have no z,
+// and its frames are particles and pictures (the surface is a 3D mesh).
 void check_plane(const Scene& scene) {
     if (scene.params.dimensions != 2) return;
     const auto off_plane = [&](const std::string& key, Vec3 v) {

@@ -269,8 +269,7 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
         setup.params.boundary.static_boxes.push_back(StaticBoxFaces{b.min, b.max, gap, carved});
         // One id space: objects[k] is body k, static_boxes[i] body (objects) + i.
         append(setup, sample_solid_box(b.min, b.max, rb, b.layers, scene.params.dimensions), Vec3{0, 0, 0},
-               kStaticBoundary,
-               static_cast<std::int32_t>(scene.objects.size() + i));
+               kStaticBoundary, static_cast<std::int32_t>(scene.objects.size() + i));
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z), Vec3d(b.max.x, b.max.y, b.max.z));
     }
     started_at(scene.fluid_temperature);  // static boxes are adiabatic too

@@ -15,7 +15,8 @@ void check_box(Vec3 lo, Vec3 hi, Real spacing, const char* what, int dimensions 
         throw InputError(std::string(what) + ": box max must exceed min on every axis");
 }
 
-// In 2D: x moved into the plane z = 0.
+// In 2D: x moved into the plane z = 0 (a box flat in z, whose surface add_box_surface makes an
+// outline).
 Vec3 flat_if(int dimensions, Vec3 x) { return dimensions == 2 ? Vec3{x.x, x.y, 0} : x; }
 
 // Points of a regular grid on the surface of [lo, hi], about `spacing` apart (the spacing is
@@ -65,10 +66,8 @@ std::vector<Vec3> sample_container_walls(Vec3 lo, Vec3 hi, Real spacing, int lay
     std::vector<Vec3> points;
     for (int layer = 0; layer < layers; ++layer) {
         const Real d = gap + layer * spacing;
-        // With no extent in z, the box's surface is the rectangle's outline.
-        const Real dz = dimensions == 2 ? Real(0) : d;
-        add_box_surface(flat_if(dimensions, {lo.x - d, lo.y - d, lo.z - dz}),
-                        flat_if(dimensions, {hi.x + d, hi.y + d, hi.z + dz}), spacing, points);
+        add_box_surface(flat_if(dimensions, {lo.x - d, lo.y - d, lo.z - d}),
+                        flat_if(dimensions, {hi.x + d, hi.y + d, hi.z + d}), spacing, points);
     }
     return points;
 }
@@ -79,9 +78,8 @@ std::vector<Vec3> sample_solid_box(Vec3 lo, Vec3 hi, Real spacing, int layers, i
     std::vector<Vec3> points;
     for (int layer = 0; layer < layers; ++layer) {
         const Real d = layer * spacing;
-        const Real dz = dimensions == 2 ? Real(0) : d;  // a rectangle's layers are outlines
-        const Vec3 a = flat_if(dimensions, {lo.x + d, lo.y + d, lo.z + dz});
-        const Vec3 b = flat_if(dimensions, {hi.x - d, hi.y - d, hi.z - dz});
+        const Vec3 a = flat_if(dimensions, {lo.x + d, lo.y + d, lo.z + d});
+        const Vec3 b = flat_if(dimensions, {hi.x - d, hi.y - d, hi.z - d});
         if (b.x < a.x || b.y < a.y || b.z < a.z) break;  // the box is full
         add_box_surface(a, b, spacing, points);
     }

@@ -17,9 +17,9 @@ std::string format_length(double x) {
 }
 
 // Σ W over an infinite square grid of `spacing` in a plane at distance `dz`, one grid point
-// straight across (in 2D: a row of points on a line). The grid's lateral offset against the fluid changes the first layer's density
-// by less than 1e-4 of ρ0 for spacings up to r0/2 (the default); at a spacing of r0 by up to 0.3%
-// for h = 2 to 2.5 r0 and 2% for h = 1.5 r0.
+// straight across (in 2D: a row of points on a line). The grid's lateral offset against the fluid
+// changes the first layer's density by less than 1e-4 of ρ0 for spacings up to r0/2 (the
+// default); at a spacing of r0 by up to 0.3% for h = 2 to 2.5 r0 and 2% for h = 1.5 r0.
 template <class Kernel>
 double sheet_sum(const Kernel& kernel, double spacing, double dz) {
     const int reach = static_cast<int>(std::ceil(double(kernel.h) / spacing)) + 1;
