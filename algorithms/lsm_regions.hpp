@@ -61,12 +61,24 @@ struct LsmObjectParams {
 
 struct SbpLink {
     // GP indices (0 .. gp_count) of the triangle's corners; a rod's SBP lies on the segment of
-    // corners 0 and 1, and repeats corner 1 as corner 2 (is_segment).
+    // corners 0 and 1, and repeats corner 1 as corner 2 (is_segment); a 2D object's SBP lies on
+    // the outline's edge from corner 0 to corner 1, and repeats corner 0 as corner 2
+    // (is_outline_edge).
     std::uint32_t corner[3];
     Vec3 bary;
     Real sign;  // +1 or -1: orients the deformed triangle's normal like the sampled one
     Real inset;  // m: the SBP sits this far inside the triangle, along its normal
     MW_HD bool is_segment() const { return corner[1] == corner[2]; }
+    MW_HD bool is_outline_edge() const { return corner[2] == corner[0] && corner[0] != corner[1]; }
+    // The face's direction at corner positions c, before `sign`: a triangle's normal, a rod
+    // segment's tangent, an outline edge's in-plane normal (the edge turned clockwise about z,
+    // outward for an outline that runs counter-clockwise around the solid).
+    MW_HD Vec3 face_direction(const Vec3 c[3]) const {
+        const Vec3 edge = c[1] - c[0];
+        if (is_segment()) return edge;
+        if (is_outline_edge()) return Vec3{edge.y, -edge.x, Real(0)};
+        return cross(edge, c[2] - c[0]);
+    }
 };
 
 struct LsmHostLayout {
@@ -363,8 +375,7 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
                 corner[c] = setup.position[s.gp[std::size_t(g)]];
             }
             link.bary = s.sbp_barycentric[k];
-            const Vec3 n = cross(corner[1] - corner[0], corner[2] - corner[0]);
-            link.sign = dot(n, s.sbp_normal[k]) < 0 ? Real(-1) : Real(1);
+            link.sign = dot(link.face_direction(corner), s.sbp_normal[k]) < 0 ? Real(-1) : Real(1);
             link.inset = s.sbp_inset.empty() ? Real(0) : s.sbp_inset[k];
             if (!(link.inset >= Real(0)) || !(link.inset < s.spacing))
                 throw InputError("solid '" + s.name + "': an SBP's inset is outside [0, r0)");

@@ -28,6 +28,7 @@
 #include "algorithms/boundary_params.hpp"
 #include "algorithms/lsm.hpp"
 #include "algorithms/neighbor_grid.hpp"
+#include "algorithms/wall_contact.hpp"
 
 MW_BACKEND_BEGIN
 
@@ -260,6 +261,7 @@ class SolidContactState {
         walls_ = true;
         wall_lo_ = params.domain_min;
         wall_hi_ = params.domain_max;
+        open_along_z_in_2d(wall_lo_, wall_hi_, params.dimensions);
         std::vector<ContactBox> boxes;
         for (const StaticBoxFaces& b : boundary.static_boxes) boxes.push_back(ContactBox{b.lo, b.hi, Real(0)});
         boxes_.upload(boxes);

@@ -1,6 +1,6 @@
 // What follows the IBPs each step (device): GPs by the paper's Eq. 19, SBPs by the barycentric
 // weights of their triangle's GPs, with the deformed triangle's normal (a rod's: its segment's
-// tangent) and interpolated velocity.
+// tangent; a 2D object's: its outline edge's normal) and interpolated velocity.
 //
 // Eq. 19: x_g = Σ_d W_gd (R_d (x0_g - x0_d) + x_d) / Σ_d W_gd over the IBPs d linked to g, R_d
 // the mean rotation of d's regions. The paper writes the IBP's goal g_d where we use the IBP's
@@ -65,7 +65,7 @@ inline void interpolate_surface(const DeviceContext& device, const Interpolation
             v += b[j] * d.velocity[gi];
         }
         // A rod's SBP stores its segment's tangent (solid_face.hpp, kSbpAround).
-        const Vec3 n = link.is_segment() ? c[1] - c[0] : link.sign * cross(c[1] - c[0], c[2] - c[0]);
+        const Vec3 n = link.is_segment() ? link.face_direction(c) : link.sign * link.face_direction(c);
         const Real len = norm(n);
         Vec3 normal = d.sbp_normal[k];  // a collapsed triangle keeps its last normal
         if (len > Real(0)) {

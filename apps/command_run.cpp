@@ -11,6 +11,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
+#include "apps/fluid_inside_objects.hpp"
 #include "apps/frame_writer.hpp"
 #include "apps/preview_picture.hpp"
 #include "apps/run_guards.hpp"
@@ -137,6 +138,7 @@ class Run {
     void open_outputs();           // frames, stats, the summary's fixed part
     void print_start();
     void write_frame();
+    void count_fluid_inside_objects();  // at each frame, moving 2D objects only
     void write_checkpoint_now();
     void check_guards(const StepReport& r, Progress& progress);
     void step_loop();
@@ -325,6 +327,7 @@ void Run::write_frame() {
     if (!frames_) return;
     sim_->download(host_);
     frames_->write(frame_index_, host_, sim_->time());
+    count_fluid_inside_objects();
     const FrameFormats& formats = frames_->formats();
     if (formats.surface) {
         FluidSurfacer::Surface surface = surfacer_->build(*sim_, host_);
@@ -354,6 +357,16 @@ void Run::write_frame() {
     }
     frame_times_.push_back(sim_->time());
     ++frame_index_;
+}
+
+void Run::count_fluid_inside_objects() {
+    if (!std::any_of(setup_.solids.begin(), setup_.solids.end(), has_moving_outline)) return;
+    long inside = 0;
+    for (long count : fluid_inside_outlines(setup_.solids, host_)) inside += std::max(0L, count);
+    ++summary_.inside_frames;
+    summary_.fluid_inside_max = std::max(summary_.fluid_inside_max, inside);
+    summary_.fluid_inside_sum += double(inside);
+    summary_.fluid_inside_last = inside;
 }
 
 // The checkpoint: the state now, with the scene and the frame clock (checkpoint_file.hpp).

@@ -32,7 +32,7 @@ std::string numbered(const char* prefix, int index, const char* extension) {
 
 // An OBJ file, atomically: a comment line, the vertices and the triangles (1-based in the file);
 // with `polyline`, one line element through every vertex in order (a rod: Blender and Houdini
-// read it as a curve's edges).
+// read it as a curve's edges). A 2D object's outline edges (a, b, a) are line elements "l a b".
 void write_obj(const std::string& path, const std::string& comment, const std::vector<std::array<double, 3>>& vertices,
                const std::vector<std::array<int, 3>>& triangles, bool polyline = false) {
     write_file_atomically(path, [&](std::ostream& out) {
@@ -43,7 +43,10 @@ void write_obj(const std::string& path, const std::string& comment, const std::v
             out << line;
         }
         for (const auto& t : triangles) {
-            std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+            if (t[2] == t[0] && t[1] != t[0])
+                std::snprintf(line, sizeof line, "l %d %d\n", t[0] + 1, t[1] + 1);
+            else
+                std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
             out << line;
         }
         if (polyline) {

@@ -1,5 +1,6 @@
 #include "apps/preview_picture.hpp"
 
+#include "apps/fluid_inside_objects.hpp"
 #include "apps/frame_writer.hpp"
 
 #include <cmath>
@@ -84,7 +85,8 @@ std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& so
             meshes.push_back(rod_tube(object_vertices(o, p), 0.5 * double(o.spacing)));
             continue;
         }
-        if (o.melts() || o.triangles.empty()) continue;  // melting: its particles show it; a box: no mesh
+        // Melting: its particles show it; a box: no mesh; a 2D object: its particles show it.
+        if (o.melts() || o.triangles.empty() || has_moving_outline(o)) continue;
         meshes.push_back(solid_preview_mesh(object_vertices(o, p), o.triangles));
     }
     return meshes;
@@ -106,7 +108,9 @@ Image preview_picture(const Scene& scene, const HostParticles& p, std::vector<Pr
         // not in the scene yet. Static boxes and melting objects have no mesh: their particles show.
         const std::uint8_t type = p.type[i];
         const std::int32_t object = p.object[i];
-        const bool meshed = object >= 0 && std::size_t(object) < scene.objects.size() && !scene.objects[object].melts();
+        // A 2D object (an outline, apps/fluid_inside_objects.hpp) shows as its particles too.
+        const bool meshed = object >= 0 && std::size_t(object) < scene.objects.size() && !scene.objects[object].melts() &&
+                            (scene.params.dimensions == 3 || scene.objects[object].kind == SolidKind::kRod);
         PreviewKind kind = PreviewKind::hidden;
         if (type == kFluid) kind = PreviewKind::fluid;
         else if (type == kStaticBoundary && object < 0) kind = PreviewKind::boundary;

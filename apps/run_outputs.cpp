@@ -228,6 +228,11 @@ void write_summary(const std::string& path, const RunSummary& run, const StatsTa
                         {"ms_per_mesh", run.surface_ms_median},
                         {"field_ms_per_mesh", run.surface_field_ms_median},
                         {"triangles_last", run.surface_triangles_last}};
+    if (run.inside_frames > 0)
+        j["fluid_inside_objects"] = {{"frames", run.inside_frames},
+                                     {"max", run.fluid_inside_max},
+                                     {"mean", run.fluid_inside_sum / run.inside_frames},
+                                     {"last", run.fluid_inside_last}};
     if (scene.frame_formats().preview) j["preview"] = {{"pictures", run.previews}, {"ms_per_picture", run.preview_ms_median}};
     const double step_seconds = stats.sum_total_ms() / 1000.0;
     j["particle_steps_per_second"] =

@@ -111,6 +111,11 @@ struct RunSummary {
     // Previews (output.formats "preview"): pictures written, the median time one took.
     int previews = 0;
     double preview_ms_median = 0;
+    // Moving 2D objects (apps/fluid_inside_objects.hpp): frames counted, and the fluid particles
+    // inside their outlines, all objects together: the most at one frame, the mean, the last.
+    int inside_frames = 0;
+    long fluid_inside_max = 0, fluid_inside_last = 0;
+    double fluid_inside_sum = 0;
     std::string stop_condition;  // "steps N" or "time T s"
     std::vector<std::string> warnings;  // about the scene, given before the run (Scene::kernel_warning)
     // A resumed run: the checkpoint it started from, and that checkpoint's step and time.

@@ -154,9 +154,10 @@ const ParamTable<SceneObject>& object_keys() {
     static const ParamTable<T> table = [] {
         ParamTable<T> t;
         t.push_back(text_key<T>("objects[].mesh", "file", member(&T::mesh_file),
-                                "an OBJ file, relative to the scene file (the shipped meshes: ../shared/assets/meshes)"));
+                                "an OBJ file (in 2D an outline file), relative to the scene file (the shipped meshes: ../shared/assets/meshes)"));
         t.push_back(text_key<T>("objects[].mesh", "procedural", member(&T::mesh_procedural),
-                                "or a procedural mesh: box:x=,y=,z= or sphere:radius= (docs/sampling.md); a rod's line:length= (docs/rods.md)"));
+                                "or a procedural mesh: box:x=,y=,z= or sphere:radius= (docs/sampling.md); a rod's line:length= (docs/rods.md); "
+                                "in 2D an outline: rectangle:x=,y=, circle:radius= (docs/scenes.md)"));
         t.push_back(vector_key<T>("objects[].transform", "scale", member(&T::scale), ParamRange::any(), "",
                                   "applied first; non-zero on every axis"));
         t.push_back(vector_key<T>("objects[].transform", "rotation_deg", member(&T::rotation_deg), ParamRange::any(),
@@ -165,6 +166,10 @@ const ParamTable<SceneObject>& object_keys() {
                                   "m", "applied last"));
         t.push_back(vector_key<T>("objects[]", "velocity", member(&T::velocity), ParamRange::any(), "m/s",
                                   "initial velocity"));
+        t.push_back(number_key<T>("objects[]", "surface_spacing", member(&T::surface_spacing),
+                                  ParamRange{0.25, 1, false, false}, "r0",
+                                  "an elastic or rigid object's surface particles at most this far apart; below 1 "
+                                  "the denser boundary a method without the correction needs (docs/coupling.md)"));
         t.push_back(number_key<T>("objects[]", "temperature", member(&T::temperature), ParamRange::celsius(), "C",
                                   "initial temperature, with heat.enabled")
                         .derive_default([](const ResolvedKeys& r) { return *r.find("fluid.temperature"); },
@@ -192,7 +197,7 @@ const ParamTable<SceneObject>& object_keys() {
 std::vector<ParamDoc> keys_read_by_hand() {
     return {
         {"dimensions", "integer", "3", "2 or 3", "",
-         "2: particles in the plane z = 0, vectors [x, y]; fluid blocks, static boxes, emitters and walls"},
+         "2: particles in the plane z = 0, vectors [x, y], objects from outlines (docs/scenes.md)"},
         {"objects[].name", "string", "\"object<i>\"", "letters, digits, _ and -; unique", "",
          "names the object's output files"},
         {"emitters[].name", "string", "\"emitter<i>\"", "letters, digits, _ and -; unique", "", "names it in info"},
@@ -284,12 +289,10 @@ void read_root(Section& root, Scene& scene) {
     }
     root.resolved().dimensions = scene.params.dimensions;
     root.record("dimensions", scene.params.dimensions);
-    // What 2D scenes do not hold yet (the resolved scene writes them as empty arrays).
+    // What 2D scenes do not hold yet (the resolved scene writes it as an empty array).
     if (scene.params.dimensions == 2)
-        for (const char* key : {"objects", "pressure_sensors"})
-            if (const SceneJson* v = root.find(key); v && !(v->is_array() && v->empty()))
-                root.fail(key, "not available in 2D scenes yet (they take fluid_blocks, static_boxes, emitters "
-                               "and the domain walls)");
+        if (const SceneJson* v = root.find("pressure_sensors"); v && !(v->is_array() && v->empty()))
+            root.fail("pressure_sensors", "not available in 2D scenes yet");
     root.read(scene_keys(), scene);
     // The name becomes the default output directory results/<name>: no path separators or dots
     // that would lead elsewhere, nothing a shell or a terminal would mangle.
@@ -355,7 +358,7 @@ void read_static_boxes(Section& root, Scene& scene) {
     });
 }
 
-void read_object_pinned(Section s, SceneObject& o) {
+void read_object_pinned(Section s, SceneObject& o, int dimensions) {
     const bool has_box = s.find("box") != nullptr, has_boxes = s.find("boxes") != nullptr,
                has_half = s.find("half_space") != nullptr;
     if (int(has_box) + int(has_boxes) + int(has_half) > 1)
@@ -364,7 +367,7 @@ void read_object_pinned(Section s, SceneObject& o) {
         Section b = s.object("box");
         o.pin = SceneObject::Pin::kBoxes;
         b.read(object_keys(), o);
-        check_box(b, o.pin_min, o.pin_max);
+        check_box(b, o.pin_min, o.pin_max, dimensions);
         o.pin_boxes.emplace_back(o.pin_min, o.pin_max);
         b.finish();
     }
@@ -372,7 +375,7 @@ void read_object_pinned(Section s, SceneObject& o) {
         o.pin = SceneObject::Pin::kBoxes;
         s.array_of_objects("boxes", [&](Section& b, int) {
             b.read(object_keys(), o);
-            check_box(b, o.pin_min, o.pin_max);
+            check_box(b, o.pin_min, o.pin_max, dimensions);
             o.pin_boxes.emplace_back(o.pin_min, o.pin_max);
         });
         if (o.pin_boxes.empty()) s.fail(s.key_path("boxes"), "must hold at least one box");
@@ -387,6 +390,25 @@ void read_object_pinned(Section s, SceneObject& o) {
     s.finish();
 }
 
+// A 2D object is an outline in the plane z = 0 (or a rod's line there), moved and turned in it:
+// elastic, rigid or rod. Static objects stop the fluid by a 3D distance field, cloth is a
+// surface, and melting builds its surface from the 26 neighbours of a 3D lattice.
+void check_object_in_plane(Section& s, const SceneObject& o, const char* kind) {
+    if (o.kind == SolidKind::kStatic || o.kind == SolidKind::kCloth)
+        s.fail(s.key_path("kind"), std::string("a 2D scene's objects are elastic, rigid or rod (this one is ") + kind +
+                                       "; a static obstacle in 2D is a static_boxes entry)");
+    if (o.melts()) s.fail(s.key_path("melting_point"), "melting is not available in 2D scenes");
+    const auto in_plane = [&](const char* key, Vec3 v) {
+        if (v.z != 0) s.fail(s.key_path(key), describe_point(v) + ": a 2D scene lies in the plane z = 0; give [x, y]");
+    };
+    in_plane("transform.translation", o.translation);
+    in_plane("velocity", o.velocity);
+    if (o.rotation_deg.x != 0 || o.rotation_deg.y != 0)
+        s.fail(s.key_path("transform.rotation_deg"),
+               describe_point(o.rotation_deg) + ": a 2D object turns in its plane only; give [0, 0, angle]");
+    if (o.pin == SceneObject::Pin::kHalfSpace) in_plane("pinned.half_space.normal", o.pin_normal);
+}
+
 void read_object(Section& s, int index, Scene& scene) {
     SceneObject o;
     o.name = read_unique_name(s, "object" + std::to_string(index), scene.objects, "objects", " (it names output files)");
@@ -398,6 +420,7 @@ void read_object(Section& s, int index, Scene& scene) {
     mesh.finish();
     Section transform = s.object("transform");
     transform.read(object_keys(), o);
+    if (scene.params.dimensions == 2) o.scale.z = 1;  // [x, y]: the outline lies in z = 0
     if (o.scale.x == 0 || o.scale.y == 0 || o.scale.z == 0)
         transform.fail(transform.key_path("scale"), "must be non-zero on every axis");
     transform.finish();
@@ -418,10 +441,14 @@ void read_object(Section& s, int index, Scene& scene) {
     if (o.melts() && !scene.params.heat.enabled)
         s.fail(s.key_path("melting_point"), "needs heat conduction: set heat.enabled to true");
     if (o.latent_heat > 0 && !o.melts()) s.fail(s.key_path("latent_heat"), "needs a melting_point");
+    if (o.surface_spacing != 1 && ((o.kind != SolidKind::kElastic && o.kind != SolidKind::kRigid) || o.melts()))
+        s.fail(s.key_path("surface_spacing"),
+               std::string("is for elastic and rigid objects that do not melt (this one is ") + kind + ")");
     Section lsm = s.object("lsm");
     lsm.read(solid_keys(), static_cast<SolidParams&>(o));
     lsm.finish();
-    read_object_pinned(s.object("pinned"), o);
+    read_object_pinned(s.object("pinned"), o, scene.params.dimensions);
+    if (scene.params.dimensions == 2) check_object_in_plane(s, o, kind);
     scene.objects.push_back(o);
 }
 

@@ -21,6 +21,8 @@ using SceneJson = nlohmann::ordered_json;  // keeps the keys in the order they w
 struct FluidBlock {
     Vec3 min{}, max{};
     Vec3 velocity{0, 0, 0};
+    // An elastic or rigid object's SBPs, spaced this many r0 apart at most (1: the method's r0).
+    double surface_spacing = 1;
     Real temperature = 20;  // C, with heat conduction (fluid.temperature by default)
 };
 
@@ -38,6 +40,8 @@ struct SceneObject : SolidParams {
     std::string mesh_procedural;  // ... or a procedural spec such as "box:x=0.5,y=0.1,z=0.1"
     Vec3 scale{1, 1, 1}, rotation_deg{0, 0, 0}, translation{0, 0, 0};
     Vec3 velocity{0, 0, 0};
+    // An elastic or rigid object's SBPs, spaced this many r0 apart at most (1: the method's r0).
+    double surface_spacing = 1;
     Real temperature = 20;  // C, with heat conduction (fluid.temperature by default)
     enum class Pin { kNone, kBoxes, kHalfSpace } pin = Pin::kNone;
     Vec3 pin_min{}, pin_max{};       // the box being read

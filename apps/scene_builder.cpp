@@ -13,6 +13,8 @@
 #include "sampling/inside_outside.hpp"
 #include "sampling/kdtree.hpp"
 #include "sampling/obj_loader.hpp"
+#include "sampling/outline.hpp"
+#include "sampling/outline_sample.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/signed_distance.hpp"
 #include "sampling/rod_sample.hpp"
@@ -69,8 +71,10 @@ void check_object_inside_domain(const Scene& scene, const Aabb& box) {
 // volume / r0³, surface particles about area / r0², plus the mesh's vertices.
 void check_object_particle_budget(const Scene& scene, const TriangleMesh& mesh, std::size_t existing) {
     const double r0 = scene.params.fluid.spacing;
-    const double total = double(existing) + std::fabs(signed_volume(mesh)) / (r0 * r0 * r0) +
-                         surface_area(mesh) / (r0 * r0) + double(mesh.vertex_count());
+    const double total = is_outline(mesh) ? double(existing) + outline_area(mesh) / (r0 * r0) +
+                                                2 * double(mesh.vertex_count())
+                                          : double(existing) + std::fabs(signed_volume(mesh)) / (r0 * r0 * r0) +
+                                                surface_area(mesh) / (r0 * r0) + double(mesh.vertex_count());
     if (total > double(kMaxSceneParticles))
         throw InputError("the scene would create about " + std::to_string(static_cast<long>(std::min(1e18, total))) +
                          " particles with this object (more than " + std::to_string(kMaxSceneParticles) +
@@ -149,7 +153,13 @@ void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& pl
                 }
         }
         if (candidates.empty()) continue;
-        const std::vector<std::uint8_t> inside = classify_points(b.mesh, candidates);
+        std::vector<std::uint8_t> inside;
+        if (is_outline(b.mesh)) {
+            const std::vector<std::array<int, 2>> edges = outline_edges(b.mesh);
+            for (const Vec3d& x : candidates) inside.push_back(inside_outline(b.mesh, edges, x.x(), x.y()) ? 1 : 0);
+        } else {
+            inside = classify_points(b.mesh, candidates);
+        }
         for (std::size_t c = 0; c < candidates.size(); ++c) inside_count[owner[c]][j] += inside[c];
     }
     // The first overlapping pair of objects in scene order is reported (after every object's
@@ -315,7 +325,8 @@ SimulationSetup build_setup(const Scene& scene, long* carved_fluid) {
                 o.kind == SolidKind::kCloth ? add_cloth_object(setup, object.mesh, solid, o.velocity, id, r0, pinned)
                 : o.kind == SolidKind::kRod ? add_rod_object(setup, object.mesh, solid, o.velocity, id, r0, pinned)
                                             : add_solid_object(setup, object.mesh, solid, o.velocity, id, r0,
-                                                               scene.params.fluid.support_radius, pinned);
+                                                               scene.params.fluid.support_radius, pinned,
+                                                               o.surface_spacing);
             object.sheet = is_thin(o.kind);
             check_pins_hold(o, setup, first, inner);
             started_at(o.temperature);
@@ -410,8 +421,11 @@ std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
 
 TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {
     TriangleMesh mesh;
+    const bool plane = scene.params.dimensions == 2;
     if (!o.mesh_procedural.empty()) {
-        mesh = make_procedural_from_spec(o.mesh_procedural);
+        // A 2D object is an outline (sampling/outline.hpp); a rod's centreline is a line in either.
+        const bool line = parse_procedural_spec(o.mesh_procedural).kind == "line";
+        mesh = plane && !line ? make_outline_from_spec(o.mesh_procedural) : make_procedural_from_spec(o.mesh_procedural);
     } else {
         std::filesystem::path path(o.mesh_file);
         if (path.is_relative() && !scene.base_dir.empty()) path = std::filesystem::path(scene.base_dir) / path;
@@ -423,7 +437,7 @@ TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {
                                                      : "the scene file's folder " + scene.base_dir) +
                              "; the meshes shipped with Meltwater are in shared/assets/meshes, beside the checkout: "
                              "../shared/assets/meshes from its root)");
-        mesh = load_obj(path.string());
+        mesh = plane ? load_outline(path.string()) : load_obj(path.string());
     }
     MeshTransform t;
     t.scale = Vec3d(o.scale.x, o.scale.y, o.scale.z);
@@ -435,12 +449,18 @@ TriangleMesh object_mesh(const Scene& scene, const SceneObject& o) {
 
 std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
                              std::int32_t object_id, double r0, double h,
-                             const std::function<bool(const Vec3&)>& pinned) {
+                             const std::function<bool(const Vec3&)>& pinned, double surface_spacing) {
     SampleOptions options;
     options.measure_coverage = false;
+    options.surface.candidate_gap *= surface_spacing;
+    options.surface.min_distance *= surface_spacing;
+    options.surface.coverage *= surface_spacing;
+    OutlineSampleOptions outline_options;
+    outline_options.surface_spacing = surface_spacing;
     // Only an elastic or rigid object's SBPs follow GPs: no refinement for the others.
     if (solid.kind == SolidKind::kStatic || solid.melts()) options.geometry_max_edge = 0;
-    const SolidSample sample = sample_solid(mesh, r0, h, options);
+    const bool outline = is_outline(mesh);  // a 2D object
+    const SolidSample sample = outline ? sample_outline(mesh, r0, h, outline_options) : sample_solid(mesh, r0, h, options);
     if (sample.ibp.count() == 0)
         throw InputError("the mesh holds no inner particle at spacing " + std::to_string(r0) +
                          " (make it larger or decrease fluid.spacing)");
@@ -484,6 +504,8 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
         solid.ibp.push_back(push(x, kInnerBoundary));
         solid.lattice.push_back(sample.ibp.lattice[k]);
         solid.pinned.push_back(pinned && pinned(x) ? 1 : 0);
+        // A 2D IBP is an r0 × r0 square of the solid (mass per unit depth, as the fluid's).
+        if (outline) solid.ibp_mass.push_back(Real(double(solid.density) * r0 * r0));
     }
     for (std::size_t g = 0; g < sample.gp.count(); ++g) solid.gp.push_back(push(to_vec3(sample.gp.positions[g]), kGeometry));
     solid.gp_offsets = sample.gp.offsets;
@@ -495,8 +517,13 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
     // set in, a light elastic cube thrown into water blew up (docs/coupling.md).
     std::vector<double> inset(sample.sbp.count(), 0.0);
     if (setup.params.coupling.surface_inset && solid.kind == SolidKind::kRigid && sample.stats.closed) {
-        const double depth = rest_density_wall_gap(Real(r0), Real(h), Real(r0 / 2), 1, setup.params.fluid.kernel);
-        inset = surface_insets(sample.geometry, sample.sbp, depth);
+        // A 2D object's SBPs are one line at their own spacing; a 3D object's, about 2.5 an r0²,
+        // stand as a wall's layer at r0/2 does.
+        const double layer_spacing = outline ? surface_spacing * r0 : r0 / 2;
+        const double depth = rest_density_wall_gap(Real(r0), Real(h), Real(layer_spacing), 1, setup.params.fluid.kernel,
+                                                   setup.params.dimensions);
+        inset = outline ? outline_insets(sample.geometry, sample.sbp, depth)
+                        : surface_insets(sample.geometry, sample.sbp, depth);
     }
     // Where each step puts them (solid_face.hpp: faded near the domain walls).
     const BoundaryParams& walls = setup.params.boundary;
@@ -595,10 +622,11 @@ std::size_t add_rod_object(SimulationSetup& setup, const TriangleMesh& line, Sol
                            std::int32_t object_id, double r0, const std::function<bool(const Vec3&)>& pinned) {
     const RodSample rod = sample_rod(line, r0);
     solid.spacing = Real(r0);
-    // One line of section r0 × r0: a node r0 from its neighbours weighs density r0³, as a
-    // lattice's IBP does.
+    // One line of section r0 × r0 (in 2D of width r0): a node r0 from its neighbours weighs
+    // density r0³ (r0²), as a lattice's IBP does.
+    const double section = setup.params.dimensions == 2 ? r0 : r0 * r0;
     std::vector<double> mass(rod.nodes.size());
-    for (std::size_t v = 0; v < mass.size(); ++v) mass[v] = double(solid.density) * r0 * r0 * rod.node_length[v];
+    for (std::size_t v = 0; v < mass.size(); ++v) mass[v] = double(solid.density) * section * rod.node_length[v];
     ThinObjectParticles particles(setup, solid, velocity, object_id);
     particles.add_nodes(rod.nodes, mass, rod.graph_offsets, rod.graph_links, pinned);
     // An SBP on segment (a, b) is a "triangle" (a, b, b) (SbpLink::is_segment); its stored

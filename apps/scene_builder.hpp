@@ -44,10 +44,12 @@ std::vector<std::uint8_t> carve_fluid(SimulationSetup& setup, Real clearance,
 // to `setup`: its IBPs, SBPs and GPs as particles (static objects: IBPs and SBPs as static boundary
 // particles) with `velocity`, and a SolidSetup built from `solid` (kind, density, LSM settings,
 // name) with the particle links filled in. IBPs for which `pinned` is true stay at rest. Returns
-// the number of inner particles, which are appended first.
+// the number of inner particles, which are appended first. An outline (sampling/outline.hpp)
+// is a 2D object. Its SBPs lie at most `surface_spacing` r0 apart (in 3D the surface sampler's
+// distances scale by it).
 std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, SolidSetup solid, Vec3 velocity,
                       std::int32_t object_id, double r0, double h,
-                      const std::function<bool(const Vec3&)>& pinned = nullptr);
+                      const std::function<bool(const Vec3&)>& pinned = nullptr, double surface_spacing = 1);
 
 // A cloth (docs/cloth.md): `mesh` (world coordinates), an open sheet, refined to edges of at most 1.5
 // r0 (sampling/sheet_sample.hpp). Each vertex is a shape-matching node (an IBP, with its share of

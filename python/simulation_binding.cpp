@@ -7,6 +7,7 @@
 
 #include <pybind11/stl.h>
 
+#include "apps/fluid_inside_objects.hpp"
 #include "common/errors.hpp"
 #include "python/bindings.hpp"
 #include "python/particle_arrays.hpp"
@@ -237,6 +238,10 @@ void bind_state(py::class_<PySimulation>& c) {
         .def("fluid_force_on_solids",
              [](const PySimulation& s) { return forces_array(idle(s).simulation().fluid_force_on_solids()); },
              "The fluid's force on each solid object in the last step, N, as an array of shape (objects, 3).")
+        .def("fluid_inside_objects",
+             [](PySimulation& s) { return fluid_inside_outlines(idle(s).solids(), *snapshot_of(s)); },
+             "Per object, the fluid particles whose centres lie inside its outline now: the penetrations the "
+             "paper's 2D figures draw in red (moving 2D objects; -1 for any other object).")
         .def("__repr__", [](const PySimulation& s) {
             if (s.busy) return std::string("<meltwater.Simulation, stepping in another thread>");
             const SimulationHandle& h = *s.h;

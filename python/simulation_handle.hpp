@@ -49,6 +49,7 @@ class SimulationHandle {
     double speed_limit() const { return runaway_.limit; }
     // The scene's warnings, as `meltwater run` prints them before its first step.
     const std::vector<std::string>& warnings() const { return warnings_; }
+    const std::vector<SolidSetup>& solids() const { return solids_; }
 
    private:
     SceneHandle scene_;

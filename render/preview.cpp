@@ -622,6 +622,11 @@ PreviewCamera default_camera(const PreviewVec& domain_lo, const PreviewVec& doma
     const D3 toward_eye{std::sin(azimuth) * std::cos(elevation), std::sin(elevation), std::cos(azimuth) * std::cos(elevation)};
     D3 target = 0.5 * (lo + hi);
     const double tan_y = std::tan(0.5 * camera.fov_y_degrees * kPi / 180), tan_x = tan_y * aspect;
+    // Head-on (a 2D scene's plane, often wide), the box is fitted left of the legend, which
+    // takes the picture's right-hand `legend` share: picture x in [-1, 1 - 2 legend] maps to
+    // [-1, 1] below.
+    const double legend = head_on ? 0.15 : 0.0;
+    const auto left_of_legend = [&](double x) { return (x + legend) / (1 - legend); };
     // The corners' extent in the picture, as a fraction of its half-size (1: touching an edge), and
     // where the middle of their bounding rectangle lies in the same units.
     const auto fit = [&](double distance, D3 aim, double* mid_x, double* mid_y) {
@@ -633,7 +638,8 @@ PreviewCamera default_camera(const PreviewVec& domain_lo, const PreviewVec& doma
         for (int k = 0; k < 8; ++k) {
             const D3 c = view.to_camera({k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z});
             if (c.z <= 0) return 1e300;
-            x0 = std::min(x0, c.x / c.z / tan_x), x1 = std::max(x1, c.x / c.z / tan_x);
+            const double x = left_of_legend(c.x / c.z / tan_x);
+            x0 = std::min(x0, x), x1 = std::max(x1, x);
             y0 = std::min(y0, c.y / c.z / tan_y), y1 = std::max(y1, c.y / c.z / tan_y);
         }
         if (mid_x) *mid_x = 0.5 * (x0 + x1), *mid_y = 0.5 * (y0 + y1);
@@ -653,7 +659,7 @@ PreviewCamera default_camera(const PreviewVec& domain_lo, const PreviewVec& doma
         fit(distance, target, &mid_x, &mid_y);
         const Projector view = make_projector(camera, 2, 2);
         const double depth = distance;  // the target's depth: a shift there moves the box by mid * tan * depth
-        target = target + (mid_x * tan_x * depth) * view.right + (mid_y * tan_y * depth) * view.up;
+        target = target + (mid_x * (1 - legend) * tan_x * depth) * view.right + (mid_y * tan_y * depth) * view.up;
     }
     fit(distance, target, nullptr, nullptr);
     return camera;

@@ -41,7 +41,7 @@ struct PreviewCamera {
 // A three-quarter view from above and in front (+z, a little to +x) of the box whose corners are
 // lo and hi (y up), far enough that all eight corners fall inside a picture of the given width /
 // height, and panned so the box sits in the middle of it. `head_on`: from straight in front (+z),
-// the view of a 2D scene's plane.
+// the view of a 2D scene's plane, the box in the part of the picture left of the legend.
 PreviewCamera default_camera(const PreviewVec& domain_lo, const PreviewVec& domain_hi, double aspect = 16.0 / 9.0,
                              bool head_on = false);
 

@@ -278,16 +278,7 @@ TriangleMesh make_procedural(const std::string& kind, const std::map<std::string
         for (const auto& kv : all) names += (names.empty() ? "" : ", ") + kv.first;
         throw InputError("unknown procedural mesh '" + kind + "' (known: " + names + ")");
     }
-    std::map<std::string, double> p = it->second;
-    for (const auto& kv : params) {
-        if (!p.count(kv.first)) {
-            std::string names;
-            for (const auto& d : it->second) names += (names.empty() ? "" : ", ") + d.first;
-            throw InputError(kind + ": unknown parameter '" + kv.first + "' (known: " + names + ")");
-        }
-        if (!std::isfinite(kv.second)) throw InputError(kind + ": parameter '" + kv.first + "' is not finite");
-        p[kv.first] = kv.second;
-    }
+    std::map<std::string, double> p = procedural_parameters(kind, it->second, params);
     TriangleMesh m;
     if (kind == "box") m = make_box(Vec3d(p["x"], p["y"], p["z"]));
     else if (kind == "hollow_box") m = make_hollow_box(Vec3d(p["x"], p["y"], p["z"]), p["wall"], p["open_top"] != 0);
@@ -299,33 +290,56 @@ TriangleMesh make_procedural(const std::string& kind, const std::map<std::string
     else if (kind == "stairs") m = make_stairs(as_int(kind, "steps", p["steps"]), p["width"], p["depth"], p["height"]);
     else if (kind == "sheet") m = make_sheet(p["x"], p["z"], as_int(kind, "nx", p["nx"]), as_int(kind, "nz", p["nz"]));
     else m = make_line(p["length"]);
-    std::ostringstream src;
-    src << kind;
-    for (const auto& kv : params) src << (kv.first == params.begin()->first ? ":" : ",") << kv.first << "=" << kv.second;
-    m.source = src.str();
+    m.source = procedural_source(kind, params);
     return m;
 }
 
-TriangleMesh make_procedural_from_spec(const std::string& spec) {
+ProceduralSpec parse_procedural_spec(const std::string& spec) {
     const std::size_t colon = spec.find(':');
-    const std::string kind = spec.substr(0, colon);
-    std::map<std::string, double> params;
-    if (colon != std::string::npos) {
-        std::stringstream rest(spec.substr(colon + 1));
-        std::string item;
-        while (std::getline(rest, item, ',')) {
-            if (item.empty()) continue;
-            const std::size_t eq = item.find('=');
-            if (eq == std::string::npos) throw InputError(spec + ": expected key=value, got '" + item + "'");
-            const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
-            char* end = nullptr;
-            const double v = std::strtod(value.c_str(), &end);
-            if (value.empty() || end == nullptr || *end != '\0')
-                throw InputError(spec + ": parameter '" + key + "' is not a number ('" + value + "')");
-            params[key] = v;
-        }
+    ProceduralSpec out;
+    out.kind = spec.substr(0, colon);
+    if (colon == std::string::npos) return out;
+    std::stringstream rest(spec.substr(colon + 1));
+    std::string item;
+    while (std::getline(rest, item, ',')) {
+        if (item.empty()) continue;
+        const std::size_t eq = item.find('=');
+        if (eq == std::string::npos) throw InputError(spec + ": expected key=value, got '" + item + "'");
+        const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (value.empty() || end == nullptr || *end != '\0')
+            throw InputError(spec + ": parameter '" + key + "' is not a number ('" + value + "')");
+        out.params[key] = v;
     }
-    return make_procedural(kind, params);
+    return out;
+}
+
+std::map<std::string, double> procedural_parameters(const std::string& kind, const std::map<std::string, double>& defaults,
+                                                    const std::map<std::string, double>& given) {
+    std::map<std::string, double> p = defaults;
+    for (const auto& kv : given) {
+        if (!p.count(kv.first)) {
+            std::string names;
+            for (const auto& d : defaults) names += (names.empty() ? "" : ", ") + d.first;
+            throw InputError(kind + ": unknown parameter '" + kv.first + "' (known: " + names + ")");
+        }
+        if (!std::isfinite(kv.second)) throw InputError(kind + ": parameter '" + kv.first + "' is not finite");
+        p[kv.first] = kv.second;
+    }
+    return p;
+}
+
+std::string procedural_source(const std::string& kind, const std::map<std::string, double>& given) {
+    std::ostringstream src;
+    src << kind;
+    for (const auto& kv : given) src << (kv.first == given.begin()->first ? ":" : ",") << kv.first << "=" << kv.second;
+    return src.str();
+}
+
+TriangleMesh make_procedural_from_spec(const std::string& spec) {
+    const ProceduralSpec parsed = parse_procedural_spec(spec);
+    return make_procedural(parsed.kind, parsed.params);
 }
 
 }  // namespace mw

@@ -36,6 +36,17 @@ TriangleMesh make_line(double length);
 TriangleMesh make_procedural(const std::string& kind, const std::map<std::string, double>& params);
 // Parses "kind" or "kind:key=value,key=value" (e.g. "sphere:radius=0.5,subdivisions=5").
 TriangleMesh make_procedural_from_spec(const std::string& spec);
+// A spec's parts: "kind" or "kind:key=value,key=value" (throws InputError on a malformed pair).
+struct ProceduralSpec {
+    std::string kind;
+    std::map<std::string, double> params;
+};
+ProceduralSpec parse_procedural_spec(const std::string& spec);
+// `defaults` overridden by `given`; throws InputError naming `kind` on an unknown or non-finite one.
+std::map<std::string, double> procedural_parameters(const std::string& kind, const std::map<std::string, double>& defaults,
+                                                    const std::map<std::string, double>& given);
+// "kind:key=value,..." of the parameters given (a made shape's source, for messages).
+std::string procedural_source(const std::string& kind, const std::map<std::string, double>& given);
 // True when `spec` names a procedural mesh ("kind" or "kind:..." with a known kind).
 bool is_procedural_spec(const std::string& spec);
 

@@ -27,6 +27,7 @@
 #include "algorithms/step_size.hpp"
 #include "algorithms/surface_field.hpp"
 #include "algorithms/two_way_coupling.hpp"
+#include "algorithms/wall_contact.hpp"
 #include "algorithms/wall_correction.hpp"
 #include "simulation/simulation.hpp"
 
@@ -244,7 +245,10 @@ void BackendSimulation<Kernel>::build_modules(const SimulationSetup& setup, cons
     NeighborSearch<Kernel>& search = add<NeighborSearch<Kernel>>(state_, lo, hi, arriving);
     SolidBodies& solids = add<SolidBodies>(device_);
     solids.init(setup, order, store);
-    solids.plan(store, params_.gravity, params_.domain_min, params_.domain_max, has_fluid && params_.coupling.predict_solids,
+    // The solids' walls: the domain's faces (in 2D its rectangle, open along z).
+    Vec3 solid_lo = params_.domain_min, solid_hi = params_.domain_max;
+    open_along_z_in_2d(solid_lo, solid_hi, Kernel::kDimensions);
+    solids.plan(store, params_.gravity, solid_lo, solid_hi, has_fluid && params_.coupling.predict_solids,
                 params_.solver.solid_substep);
     search.on_sorted([&solids, &store] {
         if (solids.active()) solids.update_slot_map(store);  // slot -> store index after the sort

@@ -45,9 +45,11 @@ TEST_CASE("2D scene: the frames hold the plane z = 0 and the picture looks at it
     CHECK(largest_z == 0);
     CHECK(lowest_top > 0);  // above the floor's layer
     CHECK(fs::exists(dir + "/frames/preview_00001.png"));
-    // Head-on: the camera stands in front of the domain's middle.
+    // Head-on: the camera stands in front of the domain's middle height, a little right of its
+    // middle so that the domain sits left of the legend.
     const auto eye = summary["scene"]["output"]["preview"]["eye"];
-    CHECK(eye[0].get<double>() == doctest::Approx(0.2));
+    CHECK(eye[0].get<double>() > 0.2);
+    CHECK(eye[0].get<double>() < 0.3);
     CHECK(eye[1].get<double>() == doctest::Approx(0.15));
     CHECK(eye[2].get<double>() > 0.3);
     // The resolved scene (camera off the plane included) reads back: a 2D run resumes.
@@ -63,7 +65,18 @@ TEST_CASE("2D scene: what it cannot hold yet, and points off the plane, are refu
         std::vector<std::string> parts;
     };
     const std::vector<Case> cases = {
-        {"objects", R"("objects": [{}])", {"objects", "not available in 2D"}},
+        {"static object", R"("objects": [{ "kind": "static", "mesh": { "procedural": "rectangle:x=0.05,y=0.05" }, "transform": { "translation": [0.3, 0.1] } }])",
+         {"objects[0].kind", "elastic, rigid or rod", "static_boxes"}},
+        {"cloth", R"("objects": [{ "kind": "cloth", "mesh": { "procedural": "rectangle:x=0.05,y=0.05" }, "transform": { "translation": [0.3, 0.1] } }])",
+         {"objects[0].kind", "elastic, rigid or rod"}},
+        {"object turned out of the plane", R"("objects": [{ "mesh": { "procedural": "rectangle:x=0.05,y=0.05" }, "transform": { "translation": [0.3, 0.1], "rotation_deg": [10, 0, 0] } }])",
+         {"objects[0].transform.rotation_deg", "[0, 0, angle]"}},
+        {"object off the plane", R"("objects": [{ "mesh": { "procedural": "rectangle:x=0.05,y=0.05" }, "transform": { "translation": [0.3, 0.1, 0.2] } }])",
+         {"objects[0].transform.translation", "plane z = 0"}},
+        {"a 3D mesh in 2D", R"("objects": [{ "mesh": { "procedural": "box:x=0.05,y=0.05,z=0.05" }, "transform": { "translation": [0.3, 0.1] } }])",
+         {"objects[0]", "unknown procedural outline 'box'", "rectangle"}},
+        {"an OBJ file in 2D", R"("objects": [{ "mesh": { "file": "missing.obj" }, "transform": { "translation": [0.3, 0.1] } }])",
+         {"objects[0]", "missing.obj"}},
         {"static box off the plane", R"("static_boxes": [{ "min": [0.2, 0, 0], "max": [0.3, 0.1, 0.1] }])",
          {"static_boxes[0].max", "plane z = 0"}},
         {"emitter off the plane", R"("emitters": [{ "center": [0.2, 0.25, 0.1], "direction": [0, -1, 0], "radius": 0.02, "speed": 1 }])",
