@@ -17,12 +17,13 @@ bool has_moving_outline(const SolidSetup& solid) {
 
 namespace {
 
-// The edges of `solid`'s outer loops: those that run counter-clockwise, as the sampler oriented
-// them (solid on the left), so that a hole (clockwise) is left out and its cavity counts inside.
-std::vector<std::array<int, 2>> outer_edges(const SolidSetup& solid, const HostParticles& p) {
+// `solid`'s outer loops, each its edges: those that run counter-clockwise, as the sampler
+// oriented them (solid on the left), so that a hole (clockwise) is left out and its cavity counts
+// inside; an island within a hole is an outer loop of its own.
+std::vector<std::vector<std::array<int, 2>>> outer_loops(const SolidSetup& solid, const HostParticles& p) {
     std::map<int, int> next;
     for (const std::array<int, 3>& t : solid.triangles) next[t[0]] = t[1];
-    std::vector<std::array<int, 2>> outer;
+    std::vector<std::vector<std::array<int, 2>>> outer;
     std::set<int> seen;
     for (const auto& [first, unused] : next) {
         if (seen.count(first)) continue;
@@ -35,7 +36,7 @@ std::vector<std::array<int, 2>> outer_edges(const SolidSetup& solid, const HostP
             twice_area += double(xa.x) * double(xb.y) - double(xb.x) * double(xa.y);
             loop.push_back({a, b});
         }
-        if (twice_area > 0) outer.insert(outer.end(), loop.begin(), loop.end());
+        if (twice_area > 0) outer.push_back(std::move(loop));
     }
     return outer;
 }
@@ -48,7 +49,16 @@ std::vector<long> fluid_inside_outlines(const std::vector<SolidSetup>& solids, c
         const SolidSetup& solid = solids[s];
         if (!has_moving_outline(solid)) continue;
         const auto at = [&](int g) { return p.position[solid.gp[std::size_t(g)]]; };
-        const std::vector<std::array<int, 2>> edges = outer_edges(solid, p);
+        const std::vector<std::vector<std::array<int, 2>>> loops = outer_loops(solid, p);
+        // Inside one outer loop by the even-odd rule (a loop of its own: none nests in another).
+        const auto inside_loop = [&](const std::vector<std::array<int, 2>>& loop, Vec3 x) {
+            bool in = false;
+            for (const std::array<int, 2>& e : loop) {
+                const Vec3 a = at(e[0]), b = at(e[1]);
+                if ((a.y > x.y) != (b.y > x.y) && x.x < a.x + (x.y - a.y) * (b.x - a.x) / (b.y - a.y)) in = !in;
+            }
+            return in;
+        };
         Real lo_x = at(0).x, hi_x = lo_x, lo_y = at(0).y, hi_y = lo_y;
         for (std::size_t g = 0; g < solid.gp.size(); ++g) {
             const Vec3 x = at(int(g));
@@ -59,12 +69,7 @@ std::vector<long> fluid_inside_outlines(const std::vector<SolidSetup>& solids, c
         for (std::size_t i = 0; i < p.position.size(); ++i) {
             const Vec3 x = p.position[i];
             if (p.type[i] != kFluid || x.x < lo_x || x.x > hi_x || x.y < lo_y || x.y > hi_y) continue;
-            bool in = false;
-            for (const std::array<int, 2>& e : edges) {
-                const Vec3 a = at(e[0]), b = at(e[1]);
-                if ((a.y > x.y) != (b.y > x.y) && x.x < a.x + (x.y - a.y) * (b.x - a.x) / (b.y - a.y)) in = !in;
-            }
-            count += in;
+            count += std::any_of(loops.begin(), loops.end(), [&](const auto& loop) { return inside_loop(loop, x); });
         }
         inside[s] = count;
     }

@@ -71,8 +71,10 @@ void check_object_inside_domain(const Scene& scene, const Aabb& box) {
 // volume / r0³, surface particles about area / r0², plus the mesh's vertices.
 void check_object_particle_budget(const Scene& scene, const TriangleMesh& mesh, std::size_t existing) {
     const double r0 = scene.params.fluid.spacing;
-    const double total = is_outline(mesh) ? double(existing) + outline_area(mesh) / (r0 * r0) +
-                                                2 * double(mesh.vertex_count())
+    // An outline: its IBPs, and along its perimeter at most 4 SBPs (surface_spacing 0.25) and 1 GP an r0.
+    const bool outline = scene.params.dimensions == 2 && is_outline(mesh);
+    const double total = outline ? double(existing) + outline_area(mesh) / (r0 * r0) +
+                                                5 * outline_perimeter(mesh) / r0 + double(mesh.vertex_count())
                                           : double(existing) + std::fabs(signed_volume(mesh)) / (r0 * r0 * r0) +
                                                 surface_area(mesh) / (r0 * r0) + double(mesh.vertex_count());
     if (total > double(kMaxSceneParticles))
@@ -154,7 +156,7 @@ void check_objects_apart(const Scene& scene, const std::vector<PlacedObject>& pl
         }
         if (candidates.empty()) continue;
         std::vector<std::uint8_t> inside;
-        if (is_outline(b.mesh)) {
+        if (scene.params.dimensions == 2) {  // an outline
             const std::vector<std::array<int, 2>> edges = outline_edges(b.mesh);
             for (const Vec3d& x : candidates) inside.push_back(inside_outline(b.mesh, edges, x.x(), x.y()) ? 1 : 0);
         } else {
@@ -459,7 +461,7 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
     outline_options.surface_spacing = surface_spacing;
     // Only an elastic or rigid object's SBPs follow GPs: no refinement for the others.
     if (solid.kind == SolidKind::kStatic || solid.melts()) options.geometry_max_edge = 0;
-    const bool outline = is_outline(mesh);  // a 2D object
+    const bool outline = setup.params.dimensions == 2;  // the object is an outline (sampling/outline.hpp)
     const SolidSample sample = outline ? sample_outline(mesh, r0, h, outline_options) : sample_solid(mesh, r0, h, options);
     if (sample.ibp.count() == 0)
         throw InputError("the mesh holds no inner particle at spacing " + std::to_string(r0) +

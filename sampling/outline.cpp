@@ -98,6 +98,7 @@ TriangleMesh make_outline(const std::vector<std::vector<Vec3d>>& loops, const st
     TriangleMesh m;
     m.source = source;
     if (loops.empty()) throw InputError(source + ": the outline holds no loop");
+    std::size_t flat_loop = 0;  // the first loop without area, reported after the crossings
     for (std::size_t l = 0; l < loops.size(); ++l) {
         const std::vector<Vec3d>& loop = loops[l];
         const int first = int(m.vertices.size());
@@ -110,15 +111,26 @@ TriangleMesh make_outline(const std::vector<std::vector<Vec3d>>& loops, const st
             throw InputError(source + ": loop " + std::to_string(l + 1) + " has " + std::to_string(loop.size()) +
                              " point(s); a loop needs at least 3");
         const int n = int(loop.size());
+        double twice_area = 0, size = 0;
         for (int k = 0; k < n; ++k) {
-            const int a = first + k, b = first + (k + 1) % n;
+            const int a = first + k, b = first + (k + 1) % n, c = first + (k + 2) % n;
             if ((m.vertices[a] - m.vertices[b]).norm() == 0)
                 throw InputError(source + ": loop " + std::to_string(l + 1) + " repeats point " + std::to_string(k + 1) +
                                  " (a zero-length edge; a loop closes by itself, do not repeat its first point)");
+            // Two edges meeting at b that fold back onto each other touch along their length,
+            // which the crossing check (edges sharing a corner are not compared) cannot see.
+            const Vec3d in = m.vertices[b] - m.vertices[a], out = m.vertices[c] - m.vertices[b];
+            if (cross2(in, out) == 0 && in.dot(out) < 0)
+                throw InputError(source + ": loop " + std::to_string(l + 1) + " folds back on itself at point " +
+                                 std::to_string((k + 1) % n + 1));
+            twice_area += cross2(m.vertices[a], m.vertices[b]);
+            size = std::max(size, in.norm());
             m.triangles.push_back({a, b, a});
         }
+        if (!(std::fabs(twice_area) > 1e-12 * size * size) && flat_loop == 0) flat_loop = l + 1;
     }
     check_simple(m, outline_edges(m));
+    if (flat_loop > 0) throw InputError(source + ": loop " + std::to_string(flat_loop) + " encloses no area");
     if (!(outline_area(m) > 0)) throw InputError(source + ": the outline encloses no area");
     return m;
 }
@@ -221,6 +233,12 @@ std::vector<std::array<int, 2>> oriented_outline_edges(const TriangleMesh& m) {
         if (!inside_outline(m, edges, mid.x() + left.x(), mid.y() + left.y())) std::swap(e[0], e[1]);
     }
     return oriented;
+}
+
+double outline_perimeter(const TriangleMesh& m) {
+    double length = 0;
+    for (const auto& e : outline_edges(m)) length += (m.vertices[std::size_t(e[1])] - m.vertices[std::size_t(e[0])]).norm();
+    return length;
 }
 
 double outline_area(const TriangleMesh& m) {

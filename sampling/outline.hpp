@@ -39,6 +39,8 @@ TriangleMesh load_outline(const std::string& path);
 // The edges oriented with the solid on their left (tested just beside each edge's middle): the
 // outer loops run counter-clockwise, the holes clockwise, whatever order they were given in.
 std::vector<std::array<int, 2>> oriented_outline_edges(const TriangleMesh& outline);
+// The edges' total length, m.
+double outline_perimeter(const TriangleMesh& outline);
 // The area enclosed (even-odd: holes subtract), m².
 double outline_area(const TriangleMesh& outline);
 // Whether point p (x, y) lies inside the outline by the even-odd rule.

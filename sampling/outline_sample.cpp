@@ -46,14 +46,27 @@ InnerParticles inner_lattice(const TriangleMesh& outline, double spacing) {
     const std::vector<std::array<int, 2>> edges = outline_edges(outline);
     const int nx = ibp.grid.dims[0], ny = ibp.grid.dims[1];
     std::vector<int> index(std::size_t(nx) * std::size_t(ny), -1);
-    for (int j = 0; j < ny; ++j)
+    std::vector<double> crossings;
+    for (int j = 0; j < ny; ++j) {
+        // A row at a time, by the even-odd rule of inside_outline: a point is inside when an odd
+        // number of the edges cross its row to its right.
+        const double y = ibp.grid.position(0, j, 0).y();
+        crossings.clear();
+        for (const auto& e : edges) {
+            const Vec3d& a = outline.vertices[std::size_t(e[0])];
+            const Vec3d& b = outline.vertices[std::size_t(e[1])];
+            if ((a.y() > y) != (b.y() > y)) crossings.push_back(a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y()));
+        }
+        std::sort(crossings.begin(), crossings.end());
         for (int i = 0; i < nx; ++i) {
             const Vec3d x = ibp.grid.position(i, j, 0);
-            if (!inside_outline(outline, edges, x.x(), x.y())) continue;
+            const auto right = crossings.end() - std::upper_bound(crossings.begin(), crossings.end(), x.x());
+            if (right % 2 == 0) continue;
             index[std::size_t(j) * std::size_t(nx) + std::size_t(i)] = int(ibp.positions.size());
             ibp.positions.push_back(x);
             ibp.lattice.push_back({i, j, 0});
         }
+    }
     ibp.neighbor_offsets.assign(1, 0);
     for (const auto& c : ibp.lattice) {
         for (int dj = -1; dj <= 1; ++dj)
@@ -98,7 +111,8 @@ SolidSample sample_outline(const TriangleMesh& outline, double spacing, double s
     if (!is_outline(outline)) throw InputError(src + ": not an outline (a 2D object's shape is closed loops of edges)");
     if (!(options.surface_spacing > 0)) throw InputError(src + ": the SBPs' spacing must be positive");
     const Vec3d extent = bounding_box(outline).extent();
-    if ((extent.x() / spacing + 1) * (extent.y() / spacing + 1) > 2e9) {
+    // The lattice's index takes 4 bytes a cell of the outline's bounding box.
+    if ((extent.x() / spacing + 1) * (extent.y() / spacing + 1) > 1e8) {
         std::ostringstream s;
         s << src << ": spacing " << spacing << " is too fine for an outline of size " << extent.x() << " x " << extent.y();
         throw InputError(s.str());

@@ -108,7 +108,7 @@ TEST_CASE("2D objects: a rigid rectangle floats at its Archimedes draft") {
 
 TEST_CASE("2D objects: the fluid counted inside a moving outline, its closed cavity included") {
     // A square 0.1 m ring (outer loop counter-clockwise, the hole's clockwise, as the sampler
-    // orients them), its GPs the particles 0-7.
+    // orients them) with a square island in its hole (counter-clockwise), its GPs the particles 0-11.
     HostParticles p;
     const auto add = [&](double x, double y, std::uint8_t type) {
         p.position.push_back(Vec3{Real(x), Real(y), 0});
@@ -117,17 +117,20 @@ TEST_CASE("2D objects: the fluid counted inside a moving outline, its closed cav
     for (const auto& c : {std::array<double, 2>{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}}) add(c[0], c[1], kGeometry);
     for (const auto& c : {std::array<double, 2>{0.03, 0.03}, {0.03, 0.07}, {0.07, 0.07}, {0.07, 0.03}})
         add(c[0], c[1], kGeometry);
+    for (const auto& c : {std::array<double, 2>{0.045, 0.045}, {0.055, 0.045}, {0.055, 0.055}, {0.045, 0.055}})
+        add(c[0], c[1], kGeometry);
     SolidSetup ring;
     ring.kind = SolidKind::kElastic;
-    for (std::uint32_t g = 0; g < 8; ++g) ring.gp.push_back(g);
-    ring.triangles = {{0, 1, 0}, {1, 2, 1}, {2, 3, 2}, {3, 0, 3}, {4, 5, 4}, {5, 6, 5}, {6, 7, 6}, {7, 4, 7}};
+    for (std::uint32_t g = 0; g < 12; ++g) ring.gp.push_back(g);
+    ring.triangles = {{0, 1, 0}, {1, 2, 1}, {2, 3, 2}, {3, 0, 3}, {4, 5, 4},    {5, 6, 5},
+                      {6, 7, 6}, {7, 4, 7}, {8, 9, 8}, {9, 10, 9}, {10, 11, 10}, {11, 8, 11}};
     add(0.01, 0.05, kFluid);   // in the wall
-    add(0.05, 0.05, kFluid);   // in the cavity
+    add(0.05, 0.05, kFluid);   // in the island, in the cavity
     add(0.15, 0.05, kFluid);   // outside
     add(0.05, 0.015, kSurfaceBoundary);  // not fluid
     CHECK(fluid_inside_outlines({ring}, p) == std::vector<long>{2});
     // Moved: the count follows the GPs.
-    for (int g = 0; g < 8; ++g) p.position[std::size_t(g)].x += Real(0.1);  // the third fluid particle now in the cavity
+    for (int g = 0; g < 12; ++g) p.position[std::size_t(g)].x += Real(0.1);  // the third fluid particle now in the island
     CHECK(fluid_inside_outlines({ring}, p) == std::vector<long>{1});
     SolidSetup rod = ring;
     rod.kind = SolidKind::kRod;

@@ -128,6 +128,9 @@ TEST_CASE("outline files: loops between blank lines, comments, and one line for 
     CHECK(refusal_of_text("bow.outline", "0 0\n1 1\n1 0\n0 1\n").find("cross") != std::string::npos);
     CHECK(refusal_of_text("repeat.outline", "0 0\n1 0\n0 1\n0 0\n").find("zero-length edge") != std::string::npos);
     CHECK(refusal_of_text("empty.outline", "# nothing\n").find("holds no loop") != std::string::npos);
+    // A loop on a line beside a good one: its edges share corners, so only the fold shows it.
+    CHECK(refusal_of_text("line.outline", "0 0\n1 0\n1 1\n0 1\n\n2 0\n3 0\n4 0\n").find("loop 2 folds back") !=
+          std::string::npos);
     CHECK(refusal_of_text("overlap.outline", "0 0\n1 0\n1 1\n0 1\n\n0.5 0.5\n2 0.5\n2 2\n").find("cross") != std::string::npos);
     try {
         load_outline("/nonexistent/shape.outline");
