@@ -9,6 +9,7 @@
 #include "apps/atomic_file.hpp"
 #include "apps/ply_writer.hpp"
 #include "apps/vtu_writer.hpp"
+#include "sampling/outline.hpp"
 #include "surface/fluid_grids.hpp"
 
 namespace mw {
@@ -43,7 +44,7 @@ void write_obj(const std::string& path, const std::string& comment, const std::v
             out << line;
         }
         for (const auto& t : triangles) {
-            if (t[2] == t[0] && t[1] != t[0])
+            if (is_outline_edge(t))
                 std::snprintf(line, sizeof line, "l %d %d\n", t[0] + 1, t[1] + 1);
             else
                 std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);

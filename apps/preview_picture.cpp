@@ -1,6 +1,5 @@
 #include "apps/preview_picture.hpp"
 
-#include "apps/fluid_inside_objects.hpp"
 #include "apps/frame_writer.hpp"
 
 #include <cmath>
@@ -78,15 +77,20 @@ PreviewMesh surface_preview_mesh(const TriangleMesh& surface) {
     return m;
 }
 
-std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& p) {
+bool drawn_as_mesh(SolidKind kind, bool melts, int dimensions) {
+    return kind == SolidKind::kRod || (!melts && dimensions == 3);
+}
+
+std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& p,
+                                               int dimensions) {
     std::vector<PreviewMesh> meshes;
     for (const SolidSetup& o : solids) {
-        if (o.kind == SolidKind::kRod && o.gp.size() > 1) {
-            meshes.push_back(rod_tube(object_vertices(o, p), 0.5 * double(o.spacing)));
+        if (!drawn_as_mesh(o.kind, o.melts(), dimensions)) continue;
+        if (o.kind == SolidKind::kRod) {
+            if (o.gp.size() > 1) meshes.push_back(rod_tube(object_vertices(o, p), 0.5 * double(o.spacing)));
             continue;
         }
-        // Melting: its particles show it; a box: no mesh; a 2D object: its particles show it.
-        if (o.melts() || o.triangles.empty() || has_moving_outline(o)) continue;
+        if (o.triangles.empty()) continue;  // a box: its particles show it
         meshes.push_back(solid_preview_mesh(object_vertices(o, p), o.triangles));
     }
     return meshes;
@@ -108,9 +112,8 @@ Image preview_picture(const Scene& scene, const HostParticles& p, std::vector<Pr
         // not in the scene yet. Static boxes and melting objects have no mesh: their particles show.
         const std::uint8_t type = p.type[i];
         const std::int32_t object = p.object[i];
-        // A 2D object (an outline, apps/fluid_inside_objects.hpp) shows as its particles too.
-        const bool meshed = object >= 0 && std::size_t(object) < scene.objects.size() && !scene.objects[object].melts() &&
-                            (scene.params.dimensions == 3 || scene.objects[object].kind == SolidKind::kRod);
+        const bool meshed = object >= 0 && std::size_t(object) < scene.objects.size() &&
+                            drawn_as_mesh(scene.objects[object].kind, scene.objects[object].melts(), scene.params.dimensions);
         PreviewKind kind = PreviewKind::hidden;
         if (type == kFluid) kind = PreviewKind::fluid;
         else if (type == kStaticBoundary && object < 0) kind = PreviewKind::boundary;

@@ -21,8 +21,13 @@ PreviewMesh surface_preview_mesh(const TriangleMesh& surface);
 // A rod drawn as a tube of `radius` (r0/2) round its line: a hexagonal prism per segment, each
 // ring square to the line there (the mean of its segments' directions).
 PreviewMesh rod_tube(const std::vector<std::array<double, 3>>& line, double radius);
+// Whether an object is drawn as its mesh, its particles hidden: a rod (as its tube) always; a
+// melting object never (its particles show what is left); in 2D nothing else (an outline has no
+// faces to draw: its particles show it).
+bool drawn_as_mesh(SolidKind kind, bool melts, int dimensions);
 // The solids' meshes at this frame (SolidSetup GPs in `particles`; static objects: their rest mesh).
-std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& particles);
+std::vector<PreviewMesh> object_preview_meshes(const std::vector<SolidSetup>& solids, const HostParticles& particles,
+                                               int dimensions);
 
 // The picture of frame `index` at time `time`. `speed_scale` (m/s): the top of the speed colour
 // bar, the same in every frame of a run (0: the frame's own range).

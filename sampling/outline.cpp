@@ -81,10 +81,8 @@ const std::map<std::string, std::map<std::string, double>>& outline_defaults() {
 
 }  // namespace
 
-bool is_outline(const TriangleMesh& mesh) {
-    return !mesh.triangles.empty() && std::all_of(mesh.triangles.begin(), mesh.triangles.end(), [](const std::array<int, 3>& t) {
-               return t[0] == t[2] || t[1] == t[2] || t[0] == t[1];
-           });
+bool is_outline(const std::vector<std::array<int, 3>>& triangles) {
+    return !triangles.empty() && std::all_of(triangles.begin(), triangles.end(), is_outline_edge);
 }
 
 std::vector<std::array<int, 2>> outline_edges(const TriangleMesh& outline) {
@@ -213,11 +211,11 @@ TriangleMesh load_outline(const std::string& path) {
     return make_outline(loops, path);
 }
 
-bool inside_outline(const TriangleMesh& m, const std::vector<std::array<int, 2>>& edges, double x, double y) {
+bool inside_loops(const std::vector<Vec3d>& points, const std::vector<std::array<int, 2>>& edges, double x, double y) {
     bool inside = false;
     for (const auto& e : edges) {
-        const Vec3d& a = m.vertices[std::size_t(e[0])];
-        const Vec3d& b = m.vertices[std::size_t(e[1])];
+        const Vec3d& a = points[std::size_t(e[0])];
+        const Vec3d& b = points[std::size_t(e[1])];
         if ((a.y() > y) != (b.y() > y) && x < a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) inside = !inside;
     }
     return inside;
@@ -241,11 +239,15 @@ double outline_perimeter(const TriangleMesh& m) {
     return length;
 }
 
-double outline_area(const TriangleMesh& m) {
-    // The shoelace sum over edges with the solid on their left: holes' edges run the other way.
+double twice_signed_area(const std::vector<Vec3d>& points, const std::vector<std::array<int, 2>>& edges) {
     double twice = 0;
-    for (const auto& e : oriented_outline_edges(m)) twice += cross2(m.vertices[std::size_t(e[0])], m.vertices[std::size_t(e[1])]);
-    return 0.5 * twice;
+    for (const auto& e : edges) twice += cross2(points[std::size_t(e[0])], points[std::size_t(e[1])]);
+    return twice;
+}
+
+double outline_area(const TriangleMesh& m) {
+    // Over edges with the solid on their left, holes' edges run the other way and subtract.
+    return 0.5 * twice_signed_area(m.vertices, oriented_outline_edges(m));
 }
 
 }  // namespace mw

@@ -13,8 +13,12 @@
 
 namespace mw {
 
-// True when every "triangle" of `mesh` is an edge (two equal corners): an outline, not a surface.
-bool is_outline(const TriangleMesh& mesh);
+// Whether a mesh "triangle" is an outline's edge (a, b, a). The device reads the same form from
+// an SBP's link (SbpLink::is_outline_edge in algorithms/lsm_regions.hpp, which cannot include this).
+inline bool is_outline_edge(const std::array<int, 3>& t) { return t[2] == t[0] && t[1] != t[0]; }
+// True when there are triangles and every one is an edge (a, b, a): an outline, not a surface.
+bool is_outline(const std::vector<std::array<int, 3>>& triangles);
+inline bool is_outline(const TriangleMesh& mesh) { return is_outline(mesh.triangles); }
 // The edges (a, b) of an outline, one per "triangle", in its order.
 std::vector<std::array<int, 2>> outline_edges(const TriangleMesh& outline);
 
@@ -43,7 +47,13 @@ std::vector<std::array<int, 2>> oriented_outline_edges(const TriangleMesh& outli
 double outline_perimeter(const TriangleMesh& outline);
 // The area enclosed (even-odd: holes subtract), m².
 double outline_area(const TriangleMesh& outline);
-// Whether point p (x, y) lies inside the outline by the even-odd rule.
-bool inside_outline(const TriangleMesh& outline, const std::vector<std::array<int, 2>>& edges, double x, double y);
+// Whether the point (x, y) lies inside the loops `edges` over `points` by the even-odd rule.
+bool inside_loops(const std::vector<Vec3d>& points, const std::vector<std::array<int, 2>>& edges, double x, double y);
+inline bool inside_outline(const TriangleMesh& outline, const std::vector<std::array<int, 2>>& edges, double x, double y) {
+    return inside_loops(outline.vertices, edges, x, y);
+}
+// Twice the signed area a closed loop of `edges` over `points` encloses (the shoelace sum):
+// positive when it runs counter-clockwise.
+double twice_signed_area(const std::vector<Vec3d>& points, const std::vector<std::array<int, 2>>& edges);
 
 }  // namespace mw
