@@ -106,13 +106,28 @@ MW_BACKEND_END
 namespace mw {
 
 // The colour field's value r0/2 outside a flat face of the prototype lattice (layers at
-// z = 0, -r0, -2 r0, ...), averaged over 8 x 8 places across one lattice cell of the face.
+// z = 0, -r0, -2 r0, ...), averaged over 8 x 8 places across one lattice cell of the face; in 2D
+// outside a flat edge (rows at y = 0, -r0, ...), over 8 places along one cell of it.
 template <class Kernel>
 double surface_iso_value(const Kernel& kernel, double spacing) {
-    const double lattice_sum = prototype_sums(kernel, spacing, 3).sum_W;
+    const double lattice_sum = prototype_sums(kernel, spacing, Kernel::kDimensions).sum_W;
     const int reach = static_cast<int>(std::ceil(kernel.h / spacing)) + 2;
     constexpr int kPlaces = 8;
     double total = 0;
+    if constexpr (Kernel::kDimensions == 2) {
+        for (int a = 0; a < kPlaces; ++a) {
+            const double px = spacing * (a + 0.5) / kPlaces, py = 0.5 * spacing;
+            double sum = 0;
+            for (int j = -reach; j <= 0; ++j)
+                for (int i = -reach; i <= reach; ++i) {
+                    const double dx = px - i * spacing, dy = py - j * spacing;
+                    const double r = std::sqrt(dx * dx + dy * dy);
+                    if (r < kernel.h) sum += kernel.W(Real(r));
+                }
+            total += sum / lattice_sum;
+        }
+        return total / kPlaces;
+    }
     for (int a = 0; a < kPlaces; ++a)
         for (int b = 0; b < kPlaces; ++b) {
             const double px = spacing * (a + 0.5) / kPlaces, py = spacing * (b + 0.5) / kPlaces, pz = 0.5 * spacing;

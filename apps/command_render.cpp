@@ -22,6 +22,7 @@
 #include "apps/vtu_reader.hpp"
 #include "common/errors.hpp"
 #include "sampling/obj_loader.hpp"
+#include "sampling/outline.hpp"
 
 namespace mw {
 
@@ -87,9 +88,47 @@ HostParticles frame_particles(const std::string& path) {
     return p;
 }
 
+// A frame's OBJ as the run wrote it: faces (a solid's mesh or the fluid's surface), one line (a
+// rod), or one "l a b" per edge (a 2D object's outline or the 2D fluid's contour, read back as an
+// outline, sampling/outline.hpp).
+TriangleMesh load_frame_obj(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path + ": cannot be read");
+    std::vector<std::string> lines;
+    int edges = 0;
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("f ", 0) == 0) return load_obj(path, false);
+        edges += line.rfind("l ", 0) == 0;
+        lines.push_back(std::move(line));
+    }
+    if (edges < 2) return load_obj(path, false);
+    TriangleMesh outline;
+    outline.source = path;
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+        std::istringstream fields(lines[k]);
+        std::string tag, rest;
+        fields >> tag;
+        double x = 0, y = 0, z = 0;
+        long a = 0, b = 0;
+        if (tag == "v" && (fields >> x >> y >> z) && !(fields >> rest)) {
+            outline.vertices.emplace_back(x, y, z);
+        } else if (tag == "l" && (fields >> a >> b) && !(fields >> rest) && a >= 1 && b >= 1 && a != b) {
+            outline.triangles.push_back({int(a - 1), int(b - 1), int(a - 1)});
+        } else if (!tag.empty() && tag[0] != '#') {
+            throw InputError(path + ":" + std::to_string(k + 1) + ": expected \"v x y z\" or \"l a b\" in an outline's OBJ");
+        }
+    }
+    for (const auto& t : outline.triangles)
+        if (std::size_t(std::max(t[0], t[1])) >= outline.vertices.size())
+            throw InputError(path + ": an edge names a vertex past the " + std::to_string(outline.vertices.size()) + " given");
+    return outline;
+}
+
 // The meshes written with frame `number`: each object's, then the fluid's surface. A rod's OBJ is
-// its line (one "l", no faces), drawn as the run's preview draws it: a tube of `rod_radius`.
-std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number, double rod_radius) {
+// its line (one "l", no faces), drawn as the run's preview draws it: a tube of `rod_radius`. A 2D
+// object's outline is not drawn (its particles show it); the 2D fluid's contour is, as a band
+// `contour_width` wide.
+std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number, double rod_radius, double contour_width) {
     std::vector<PreviewMesh> meshes;
     std::vector<std::string> objects;
     for (const auto& entry : fs::directory_iterator(frames_dir)) {
@@ -103,7 +142,8 @@ std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number,
         return v;
     };
     for (const std::string& name : objects) {
-        const TriangleMesh m = load_obj(frames_dir + "/" + name, false);
+        const TriangleMesh m = load_frame_obj(frames_dir + "/" + name);
+        if (is_outline(m)) continue;
         if (m.triangles.empty() && m.vertices.size() > 1)
             meshes.push_back(rod_tube(vertices_of(m), rod_radius));
         else
@@ -111,7 +151,8 @@ std::vector<PreviewMesh> frame_meshes(const std::string& frames_dir, int number,
     }
     char surface[40];
     std::snprintf(surface, sizeof surface, "/surface_%05d.obj", number);
-    if (fs::exists(frames_dir + surface)) meshes.push_back(surface_preview_mesh(load_obj(frames_dir + surface, false)));
+    if (fs::exists(frames_dir + surface))
+        meshes.push_back(surface_preview_mesh(load_frame_obj(frames_dir + surface), contour_width));
     return meshes;
 }
 
@@ -213,7 +254,7 @@ int command_render(int argc, char** argv) {
         std::snprintf(name, sizeof name, "/particles_%05d.vtu", number);
         const HostParticles particles = frame_particles(frames_dir + name);
         const double time = times.count(number) ? times.at(number) : number / scene.fps;
-        const Image picture = preview_picture(scene, particles, frame_meshes(frames_dir, number, rod_radius), time,
+        const Image picture = preview_picture(scene, particles, frame_meshes(frames_dir, number, rod_radius, kContourWidthInR0 * double(scene.params.fluid.spacing)), time,
                                               number, scale);
         std::snprintf(name, sizeof name, "/preview_%05d.png", number);
         last = out_dir + name;

@@ -348,7 +348,7 @@ void Run::write_frame() {
     if (formats.preview) {
         const auto start = std::chrono::steady_clock::now();
         std::vector<PreviewMesh> meshes = object_preview_meshes(setup_.solids, host_, scene_.params.dimensions);
-        if (formats.surface) meshes.push_back(surface_preview_mesh(last_surface_));
+        if (formats.surface) meshes.push_back(surface_preview_mesh(last_surface_, kContourWidthInR0 * double(scene_.params.fluid.spacing)));
         last_preview_ = frames_->write_preview(
             frame_index_, preview_picture(scene_, host_, std::move(meshes), sim_->time(), frame_index_, runaway_.scale()));
         preview_ms_.push_back(seconds_since(start) * 1000);

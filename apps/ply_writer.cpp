@@ -5,6 +5,7 @@
 #include <ostream>
 
 #include "apps/atomic_file.hpp"
+#include "sampling/outline.hpp"
 
 namespace mw {
 
@@ -77,10 +78,14 @@ void write_ply_points(const std::string& path, const std::vector<Vec3>& points, 
 
 void write_ply_mesh(const std::string& path, const std::vector<std::array<double, 3>>& vertices,
                     const std::vector<std::array<int, 3>>& triangles, const std::string& comment) {
+    const bool edges = is_outline(triangles);
+    const std::string elements = edges ? "\nelement edge " + std::to_string(triangles.size()) +
+                                             "\nproperty int vertex1\nproperty int vertex2"
+                                       : "\nelement face " + std::to_string(triangles.size()) +
+                                             "\nproperty list uchar int vertex_indices";
     const std::string header = "ply\nformat binary_little_endian 1.0\ncomment " + one_line(comment) +
                                "\nelement vertex " + std::to_string(vertices.size()) +
-                               "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-                               std::to_string(triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+                               "\nproperty float x\nproperty float y\nproperty float z" + elements + "\nend_header\n";
     write_file_atomically(path, [&](std::ostream& out) {
         out << header;
         std::string bytes;
@@ -88,6 +93,11 @@ void write_ply_mesh(const std::string& path, const std::vector<std::array<double
         for (const auto& v : vertices)
             for (double x : v) put(bytes, float(x));
         for (const auto& t : triangles) {
+            if (edges) {
+                put(bytes, std::int32_t(t[0]));
+                put(bytes, std::int32_t(t[1]));
+                continue;
+            }
             put(bytes, std::uint8_t(3));
             for (int index : t) put(bytes, std::int32_t(index));
         }

@@ -15,7 +15,9 @@ namespace mw {
 void write_ply_points(const std::string& path, const std::vector<Vec3>& points, const std::vector<VtuArray>& arrays,
                       const std::string& comment);
 
-// A triangle mesh: vertices x, y, z (float) and faces as lists of three vertex indices.
+// A triangle mesh: vertices x, y, z (float) and faces as lists of three vertex indices; an
+// outline (every triangle an edge (a, b, a), sampling/outline.hpp: the 2D fluid's contour) as
+// edge elements (vertex1, vertex2) instead, as PLY readers take a curve.
 void write_ply_mesh(const std::string& path, const std::vector<std::array<double, 3>>& vertices,
                     const std::vector<std::array<int, 3>>& triangles, const std::string& comment);
 

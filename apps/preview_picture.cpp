@@ -1,6 +1,7 @@
 #include "apps/preview_picture.hpp"
 
 #include "apps/frame_writer.hpp"
+#include "sampling/outline.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -66,7 +67,29 @@ PreviewMesh solid_preview_mesh(const std::vector<std::array<double, 3>>& vertice
     return m;
 }
 
-PreviewMesh surface_preview_mesh(const TriangleMesh& surface) {
+PreviewMesh surface_preview_mesh(const TriangleMesh& surface, double line_width) {
+    if (is_outline(surface)) {
+        PreviewMesh band;
+        band.colour = {20, 70, 170};
+        band.smooth = false;
+        // In front of the particles' discs (r0/2 deep) by a line width, a quad per edge.
+        const double z = 2 * line_width;
+        for (const auto& t : surface.triangles) {
+            const Vec3d& a = surface.vertices[std::size_t(t[0])];
+            const Vec3d& b = surface.vertices[std::size_t(t[1])];
+            const Vec3d d = b - a;
+            const double length = std::hypot(d.x(), d.y());
+            if (!(length > 0)) continue;
+            const double nx = -d.y() / length * 0.5 * line_width, ny = d.x() / length * 0.5 * line_width;
+            const auto first = std::uint32_t(band.vertices.size() / 3);
+            for (const auto& [px, py] : {std::pair{a.x() - nx, a.y() - ny}, std::pair{b.x() - nx, b.y() - ny},
+                                         std::pair{b.x() + nx, b.y() + ny}, std::pair{a.x() + nx, a.y() + ny}})
+                band.vertices.insert(band.vertices.end(), {float(px), float(py), float(z)});
+            // Counter-clockwise seen from +z, where the head-on camera stands.
+            band.triangles.insert(band.triangles.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
+        }
+        return band;
+    }
     std::vector<std::array<double, 3>> vertices(surface.vertices.size());
     for (std::size_t v = 0; v < vertices.size(); ++v)
         vertices[v] = {surface.vertices[v].x(), surface.vertices[v].y(), surface.vertices[v].z()};

@@ -17,7 +17,12 @@ namespace mw {
 // A mesh for the preview: a solid's (grey, opaque) or the fluid's surface (water blue, translucent).
 PreviewMesh solid_preview_mesh(const std::vector<std::array<double, 3>>& vertices,
                                const std::vector<std::array<int, 3>>& triangles);
-PreviewMesh surface_preview_mesh(const TriangleMesh& surface);
+// In 2D the surface is a contour (edges (a, b, a), surface/contour.hpp): drawn as a band
+// `line_width` wide in front of the plane's particles, the camera looking at it head-on.
+PreviewMesh surface_preview_mesh(const TriangleMesh& surface, double line_width);
+// The contour's band, in r0: about two pixels at the preview's default size on a 2D scene a
+// hundred r0 wide.
+constexpr double kContourWidthInR0 = 0.3;
 // A rod drawn as a tube of `radius` (r0/2) round its line: a hexagonal prism per segment, each
 // ring square to the line there (the mean of its segments' directions).
 PreviewMesh rod_tube(const std::vector<std::array<double, 3>>& line, double radius);

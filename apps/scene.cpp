@@ -83,7 +83,8 @@ const ParamTable<Scene>& scene_keys() {
                                   "frames per simulated second, plus frame 0"));
         t.push_back(text_list_key<T>("output", "formats", member(&T::formats), {"vtu", "ply", "surface", "vdb", "preview"},
                                      "what each frame writes: particles (vtu, ply), the fluid's surface mesh (surface; "
-                                     "as PLY too with ply), its level set and colour field (vdb), a picture (preview)"));
+                                     "in 2D its contour; as PLY too with ply), its level set and colour field (vdb, 3D), "
+                                     "a picture (preview)"));
         t.push_back(number_key<T>("output.surface", "voxel", member(&T::surface_voxel), ParamRange{0.1, 4, false, false},
                                   "r0", "the surface field's node spacing"));
         t.push_back(integer_key<T>("output.preview", "width", [](auto& s) -> auto& { return s.preview.width; }, 16,
@@ -574,9 +575,9 @@ void check_plane(const Scene& scene) {
         off_plane(key + ".max", scene.static_boxes[i].max);
     }
     const FrameFormats f = scene.frame_formats();
-    if (f.surface || f.vdb)
-        throw InputError(scene.source + ": output.formats: \"surface\" and \"vdb\" are 3D outputs; a 2D scene "
-                         "writes vtu, ply and preview frames");
+    if (f.vdb)
+        throw InputError(scene.source + ": output.formats: \"vdb\" is a 3D output (volumes); a 2D scene writes vtu, ply, "
+                         "surface (the fluid's contour) and preview frames");
 }
 
 // The preview's camera must look somewhere, and temperature colours only what heat conduction gives one.

@@ -1,5 +1,6 @@
 #include "surface/fluid_surface.hpp"
 #include "surface/color_grid.hpp"
+#include "surface/contour.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -25,23 +26,23 @@ namespace {
 Real node_margin(Real support_radius, Real spacing) { return support_radius + Real(1.25) * spacing; }
 }  // namespace
 
-std::array<double, 3> surface_node_dims(Vec3 lo, Vec3 hi, Real support_radius, Real spacing) {
+std::array<double, 3> surface_node_dims(Vec3 lo, Vec3 hi, Real support_radius, Real spacing, int dimensions) {
     const double margin = double(node_margin(support_radius, spacing));
     const double extent[3] = {double(hi.x - lo.x), double(hi.y - lo.y), double(hi.z - lo.z)};
-    std::array<double, 3> dims{};
-    for (int a = 0; a < 3; ++a) dims[a] = std::ceil((extent[a] + 2 * margin) / double(spacing)) + 1;
+    std::array<double, 3> dims{1, 1, 1};
+    for (int a = 0; a < dimensions; ++a) dims[a] = std::ceil((extent[a] + 2 * margin) / double(spacing)) + 1;
     return dims;
 }
 
 double most_surface_nodes(const SimulationParams& params, Real spacing) {
     const Real h = params.fluid.support_radius;
     const std::array<double, 3> dims = surface_node_dims(params.domain_min - Vec3{h, h, h},
-                                                         params.domain_max + Vec3{h, h, h}, h, spacing);
+                                                         params.domain_max + Vec3{h, h, h}, h, spacing, params.dimensions);
     return dims[0] * dims[1] * dims[2];
 }
 
 SurfaceNodes surface_nodes_around_fluid(const HostParticles& particles, Vec3 domain_min, Vec3 domain_max,
-                                        Real support_radius, Real spacing) {
+                                        Real support_radius, Real spacing, int dimensions) {
     SurfaceNodes nodes;
     nodes.spacing = spacing;
     const Real inf = std::numeric_limits<Real>::infinity(), h = support_radius;
@@ -59,11 +60,11 @@ SurfaceNodes surface_nodes_around_fluid(const HostParticles& particles, Vec3 dom
         any = true;
     }
     if (!any) return nodes;
-    const std::array<double, 3> dims = surface_node_dims(lo, hi, support_radius, spacing);
+    const std::array<double, 3> dims = surface_node_dims(lo, hi, support_radius, spacing, dimensions);
     if (dims[0] * dims[1] * dims[2] > double(kMaxSurfaceNodes))
         throw std::logic_error("surface_nodes_around_fluid: more nodes than resolve_scene's check allows");
     const Real margin = node_margin(support_radius, spacing);
-    nodes.origin = Vec3{lo.x - margin, lo.y - margin, lo.z - margin};
+    nodes.origin = Vec3{lo.x - margin, lo.y - margin, dimensions == 3 ? lo.z - margin : Real(0)};
     for (int a = 0; a < 3; ++a) nodes.dims[a] = static_cast<int>(dims[a]);
     return nodes;
 }
@@ -122,6 +123,7 @@ FluidSurfacer::FluidSurfacer(const SimulationParams& params, double voxel_in_r0,
       domain_max_(params.domain_max),
       support_radius_(params.fluid.support_radius),
       spacing_(Real(voxel_in_r0) * params.fluid.spacing),
+      dimensions_(params.dimensions),
       threads_(threads) {}
 
 namespace {
@@ -133,7 +135,7 @@ double ms_since(SurfaceClock::time_point t) {
 
 const FluidSurfacer::Field& FluidSurfacer::field(Simulation& sim, const HostParticles& particles) {
     const auto start = SurfaceClock::now();
-    field_.nodes = surface_nodes_around_fluid(particles, domain_min_, domain_max_, support_radius_, spacing_);
+    field_.nodes = surface_nodes_around_fluid(particles, domain_min_, domain_max_, support_radius_, spacing_, dimensions_);
     field_.iso = 0;
     field_.color.clear();
     if (field_.nodes.count() > 0) sim.fluid_color_field(field_.nodes, field_.color, field_.iso);
@@ -146,7 +148,8 @@ FluidSurfacer::Surface FluidSurfacer::build(Simulation& sim, const HostParticles
     const auto start = SurfaceClock::now();
     field(sim, particles);
     out.field_ms = field_.ms;
-    out.mesh = mesh_color_field(field_.nodes, field_.color, field_.iso, threads_);
+    out.mesh = dimensions_ == 2 ? contour_color_field(field_.nodes, field_.color, field_.iso)
+                                : mesh_color_field(field_.nodes, field_.color, field_.iso, threads_);
     out.ms = ms_since(start);
     return out;
 }

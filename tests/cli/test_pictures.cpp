@@ -7,8 +7,7 @@
 #include <filesystem>
 
 #include "cli_helpers.hpp"
-
-#include <stb_image.h>
+#include "pictures.hpp"
 
 using namespace cli_test;
 namespace fs = std::filesystem;
@@ -24,27 +23,6 @@ std::pair<long, long> png_size(const std::string& path) {
         return v;
     };
     return {big_endian(16), big_endian(20)};
-}
-
-// A PNG's RGB bytes (empty when it does not decode).
-using Pixels = std::vector<unsigned char>;
-Pixels png_pixels(const std::string& path) {
-    const std::string bytes = slurp(path);
-    int width = 0, height = 0, channels = 0;
-    unsigned char* data = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()), int(bytes.size()),
-                                                &width, &height, &channels, 3);
-    if (!data) return {};
-    Pixels out(data, data + std::size_t(width) * std::size_t(height) * 3);
-    stbi_image_free(data);
-    return out;
-}
-
-// How many pixels of two pictures of the same size differ.
-std::size_t differing_pixels(const Pixels& a, const Pixels& b) {
-    std::size_t differing = 0;
-    for (std::size_t k = 0; k + 2 < a.size() && k + 2 < b.size(); k += 3)
-        differing += a[k] != b[k] || a[k + 1] != b[k + 1] || a[k + 2] != b[k + 2];
-    return differing;
 }
 
 std::string box_scene() { return tiny_scene_with_box("pictures_box.json"); }

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <utility>
 
+#include "sampling/outline.hpp"
+#include "surface/contour.hpp"
 #include "surface/fluid_surface.hpp"
 #include "tests/core/test_setups.hpp"
 #include "tests/skip.hpp"
@@ -34,7 +36,7 @@ Surfaced surface_of(Simulation& sim, const SimulationSetup& setup, double voxel_
     sim.download(host);
     for (std::uint8_t t : host.type) out.fluid += t == kFluid;
     out.nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max,
-                                           setup.params.fluid.support_radius, Real(voxel_in_r0) * kR0);
+                                           setup.params.fluid.support_radius, Real(voxel_in_r0) * kR0, 3);
     sim.fluid_color_field(out.nodes, out.color, out.iso);
     out.mesh = mesh_color_field(out.nodes, out.color, out.iso, 0);
     return out;
@@ -199,7 +201,7 @@ TEST_CASE("surface: no fluid in the domain, no nodes and an empty mesh") {
     host.type = setup.type;
     for (Vec3& x : host.position) x.z += 5;  // lost far above the domain
     const SurfaceNodes nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max,
-                                                          setup.params.fluid.support_radius, kR0);
+                                                          setup.params.fluid.support_radius, kR0, 3);
     CHECK(nodes.count() == 0);
     CHECK(mesh_color_field(nodes, {}, 0.3, 0).triangles.empty());
 }
@@ -214,14 +216,14 @@ TEST_CASE("surface: the scene's bound on the nodes holds fluid anywhere the node
     host.type = {kFluid, kFluid};
     for (Real spacing : {Real(0.25) * kR0, Real(0.5) * kR0, kR0}) {
         CAPTURE(spacing);
-        const SurfaceNodes nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max, h, spacing);
+        const SurfaceNodes nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max, h, spacing, 3);
         REQUIRE(nodes.count() > 0);
         CHECK(double(nodes.count()) <= most_surface_nodes(setup.params, spacing));
         CHECK(double(nodes.count()) > 0.99 * most_surface_nodes(setup.params, spacing));
     }
     // Beyond one support radius: left out, as lost fluid.
     host.position[1] = host.position[1] + Vec3{kR0, 0, 0};
-    const SurfaceNodes one = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max, h, kR0);
+    const SurfaceNodes one = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max, h, kR0, 3);
     CHECK(one.count() < 1000);
 }
 
@@ -262,4 +264,129 @@ TEST_CASE("surface: the CUDA backend's colour field matches OpenMP's") {
     CHECK(worst < 1e-5);
     CHECK(a.iso == b.iso);
     CHECK(a.mesh.triangles.size() == b.mesh.triangles.size());
+}
+
+// ---- 2D: the contour (surface/contour.hpp) ----------------------------------------------------
+
+namespace {
+
+// The fluid of a 2D `sim` contoured at `voxel_in_r0` r0.
+Surfaced contour_of(Simulation& sim, const SimulationSetup& setup, double voxel_in_r0) {
+    Surfaced out;
+    HostParticles host;
+    sim.download(host);
+    for (std::uint8_t t : host.type) out.fluid += t == kFluid;
+    out.nodes = surface_nodes_around_fluid(host, setup.params.domain_min, setup.params.domain_max,
+                                           setup.params.fluid.support_radius, Real(voxel_in_r0) * kR0, 2);
+    sim.fluid_color_field(out.nodes, out.color, out.iso);
+    out.mesh = contour_color_field(out.nodes, out.color, out.iso);
+    return out;
+}
+
+// Closed loops: every vertex starts exactly one edge and ends exactly one. Returns the loops' count
+// (0 when not closed).
+int closed_loops(const TriangleMesh& contour) {
+    std::vector<int> starts(contour.vertices.size()), ends(contour.vertices.size()), next(contour.vertices.size(), -1);
+    for (const auto& t : contour.triangles) ++starts[std::size_t(t[0])], ++ends[std::size_t(t[1])], next[std::size_t(t[0])] = t[1];
+    for (std::size_t v = 0; v < starts.size(); ++v)
+        if (starts[v] != 1 || ends[v] != 1) return 0;
+    std::vector<bool> seen(contour.vertices.size());
+    int loops = 0;
+    for (std::size_t v = 0; v < seen.size(); ++v) {
+        if (seen[v]) continue;
+        ++loops;
+        for (int w = int(v); !seen[std::size_t(w)]; w = next[std::size_t(w)]) seen[std::size_t(w)] = true;
+    }
+    return loops;
+}
+
+// The area the loops enclose, signed: positive for loops run counter-clockwise (the fluid on the
+// left of an outer boundary), a hole's loop subtracting.
+double enclosed_area(const TriangleMesh& contour) { return 0.5 * twice_signed_area(contour.vertices, outline_edges(contour)); }
+
+SimulationSetup plane_at_rest(Vec3 lo, Vec3 hi, Real support_in_r0 = 2, KernelKind kernel = KernelKind::kCubicSpline) {
+    return fluid_in_box(Vec3{0, 0, 0}, Vec3{0.6f, 0.6f, 0}, lo, hi, kR0, Real(0.001), false, support_in_r0, kernel, 2);
+}
+
+}  // namespace
+
+TEST_CASE("surface in 2D: a lattice block's contour is one closed loop, the fluid on its left, round N r0^2") {
+    for (const auto& support_and_kernel : {std::pair{Real(2), KernelKind::kCubicSpline},
+                                           std::pair{Real(2.5), KernelKind::kWendlandC2}})
+    for (double voxel : {0.5, 0.25, 1.0}) {
+        const Real support = support_and_kernel.first;
+        const KernelKind kernel = support_and_kernel.second;
+        const SimulationSetup setup = plane_at_rest(Vec3{0.1f, 0.1f, 0}, Vec3{0.3f, 0.26f, 0}, support, kernel);
+        const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup, 0);
+        CAPTURE(std::string(kernel_name(kernel)));
+        CAPTURE(voxel);
+        const Surfaced s = contour_of(*sim, setup, voxel);
+        REQUIRE(s.fluid == 80);
+        REQUIRE(s.nodes.dims[2] == 1);
+        MESSAGE("2D iso-value, " << std::string(kernel_name(kernel)) << ": " << s.iso);
+        CHECK(s.iso > 0.2);
+        CHECK(s.iso < 0.8);
+        REQUIRE(is_outline(s.mesh));
+        CHECK(closed_loops(s.mesh) == 1);
+        const double area = enclosed_area(s.mesh), particles_area = double(s.fluid) * kR0 * kR0;
+        MESSAGE("2D block, " << std::string(kernel_name(kernel)) << ", at voxel " << voxel << " r0: " << area / particles_area
+                             << " of N r0^2");
+        // Counter-clockwise round the fluid; the corners round off over the field's reach.
+        CHECK(area / particles_area > (voxel < 1 ? 0.95 : 0.93));
+        CHECK(area / particles_area < 1.0);
+        // Every side r0/2 outside the outermost row of particles (at 0.11 .. 0.29 x 0.25 m).
+        double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+        for (const Vec3d& v : s.mesh.vertices) {
+            CHECK(v.z() == 0);
+            x0 = std::min(x0, v.x()), x1 = std::max(x1, v.x()), y0 = std::min(y0, v.y()), y1 = std::max(y1, v.y());
+        }
+        const double half = 0.5 * kR0, tolerance = 0.1 * kR0;
+        CHECK(std::abs(x0 - (0.11 - half)) < tolerance);
+        CHECK(std::abs(x1 - (0.29 + half)) < tolerance);
+        CHECK(std::abs(y0 - (0.11 - half)) < tolerance);
+        CHECK(std::abs(y1 - (0.25 + half)) < tolerance);
+        // About one edge per voxel of the outline: no slivers where a side lies on a line of nodes.
+        const double per_voxel = double(s.mesh.triangles.size()) / (2 * (0.2 + 0.16) / (voxel * kR0));
+        MESSAGE("edges per voxel of outline: " << per_voxel);
+        CHECK(per_voxel > 0.9);
+        CHECK(per_voxel < 1.3);
+    }
+}
+
+TEST_CASE("surface in 2D: a lattice disc's contour is round, and a ring's hole is a loop wound the other way") {
+    const Vec3 centre{0.3f, 0.3f, 0};
+    const Real radius = 8 * kR0;
+    for (const Real hole : {Real(0), Real(4) * kR0}) {
+        CAPTURE(hole);
+        SimulationSetup setup = plane_at_rest(centre - Vec3{radius, radius, 0}, centre + Vec3{radius, radius, 0});
+        SimulationSetup disc = setup;
+        disc.position.clear(), disc.velocity.clear(), disc.type.clear(), disc.object.clear();
+        for (std::size_t i = 0; i < setup.position.size(); ++i) {
+            const Real r = norm(setup.position[i] - centre);
+            if (r > radius || (hole > 0 && r < hole)) continue;
+            disc.position.push_back(setup.position[i]);
+            disc.velocity.push_back(setup.velocity[i]);
+            disc.type.push_back(setup.type[i]);
+            disc.object.push_back(setup.object[i]);
+        }
+        const std::unique_ptr<Simulation> sim = create_openmp_simulation(disc, 0);
+        const Surfaced s = contour_of(*sim, disc, 0.5);
+        REQUIRE(s.fluid > 100);
+        CHECK(closed_loops(s.mesh) == (hole > 0 ? 2 : 1));
+        const double particles_area = double(s.fluid) * kR0 * kR0, area = enclosed_area(s.mesh);
+        MESSAGE((hole > 0 ? "ring" : "disc") << " of " << s.fluid << " particles: " << area / particles_area << " of N r0^2");
+        CHECK(area / particles_area > 0.95);
+        CHECK(area / particles_area < 1.03);
+        if (hole > 0) continue;
+        // The radius of a disc of the particles' area; a lattice disc is faceted by about 0.3 r0.
+        const double expected = std::sqrt(particles_area / kPi);
+        double nearest = 1e9, farthest = 0;
+        for (const Vec3d& v : s.mesh.vertices) {
+            const double r = std::hypot(v.x() - centre.x, v.y() - centre.y);
+            nearest = std::min(nearest, r), farthest = std::max(farthest, r);
+        }
+        MESSAGE("disc: radii " << (nearest - expected) / kR0 << " to " << (farthest - expected) / kR0 << " r0 from the area's");
+        CHECK(nearest > expected - 0.35 * kR0);
+        CHECK(farthest < expected + 0.35 * kR0);
+    }
 }
