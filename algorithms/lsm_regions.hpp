@@ -534,8 +534,9 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
 }
 
 // Per lattice vertex, how many of its 26 one-ring neighbours are present (among the `alive` ones
-// when given: per vertex, 0 for a gone one). A melting object's vertex with all 26 is an IBP,
-// any other an SBP (docs/method.md, "Particles").
+// when given: per vertex, 0 for a gone one); in 2D (a lattice in one plane) 8 at most. A melting
+// object's vertex with all of them (full_one_ring) is an IBP, any other an SBP (docs/method.md,
+// "Particles").
 inline std::vector<std::uint8_t> lattice_one_ring_counts(const std::vector<std::array<int, 3>>& lattice,
                                                          const std::vector<std::uint8_t>& alive = {}) {
     std::vector<std::uint8_t> count(lattice.size(), 0);
@@ -555,7 +556,8 @@ inline std::vector<std::uint8_t> lattice_one_ring_counts(const std::vector<std::
     }
     return count;
 }
-constexpr int kFullOneRing = 26;
+// A lattice vertex's one-ring neighbours in `dimensions` (2 or 3): 3^D - 1.
+constexpr int full_one_ring(int dimensions) { return dimensions == 2 ? 8 : 26; }
 
 // Rebuilds the regions of one elastic object, its IBPs in slots [base, base + lattice.size()),
 // over the vertices still `alive` (per slot, over all of L's IBP slots): the regions, split masses

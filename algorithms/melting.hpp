@@ -157,6 +157,7 @@ class PhaseChange final : public Module {
         temperature_ = store.find<Real>("temperature");
         if (!temperature_) throw InputError("simulation setup: melting needs heat conduction");
         ibp_count_ = solids.ibp_count();
+        full_ring_ = full_one_ring(setup.params.dimensions);
         points_.upload(points);
         latent_ = &store.add<Real>("latent_heat", FieldLife::kPersistent);
         latent_->fill(Real(0));
@@ -169,6 +170,7 @@ class PhaseChange final : public Module {
         // The melting objects' particles must carry the SBP type exactly where a one-ring
         // neighbour is missing: that is what decides which may melt.
         const std::vector<std::uint8_t>& type_of_scene = setup.type;
+        const int full_ring = full_ring_;
         for (const auto& m : solids.melting_lattices()) {
             lattice_particles_ += long(m.lattice.size());
             grids_.emplace_back(m.lattice);
@@ -176,11 +178,12 @@ class PhaseChange final : public Module {
             std::copy(ring.begin(), ring.end(), ring_.begin() + long(m.base));
             const SolidSetup& solid = setup.solids[m.object];
             for (std::size_t k = 0; k < m.lattice.size(); ++k) {
-                const std::uint8_t expected = ring[k] < kFullOneRing ? kSurfaceBoundary : kInnerBoundary;
+                const std::uint8_t expected = ring[k] < full_ring ? kSurfaceBoundary : kInnerBoundary;
                 if (type_of_scene[solid.ibp[k]] != expected)
                     throw InputError("simulation setup: solid \"" + solid.name +
                                      "\" melts; a lattice vertex with " + std::to_string(int(ring[k])) +
-                                     " of its 26 one-ring neighbours must have the " + particle_type_name(expected) +
+                                     " of its " + std::to_string(full_ring) + " one-ring neighbours must have the " +
+                                     particle_type_name(expected) +
                                      " type");
             }
         }
@@ -255,7 +258,7 @@ class PhaseChange final : public Module {
                             const std::int32_t q = grid.at(ci + di, cj + dj, ck + dk);
                             if ((di | dj | dk) == 0 || q < 0) continue;
                             const std::size_t s = m.base + std::size_t(q);
-                            if (ring_[s]-- == kFullOneRing && alive_[s]) exposed.push_back(std::uint32_t(s));
+                            if (ring_[s]-- == full_ring_ && alive_[s]) exposed.push_back(std::uint32_t(s));
                         }
             }
         }
@@ -327,6 +330,7 @@ class PhaseChange final : public Module {
     long melted_total_ = 0;
     long lattice_particles_ = 0;               // of the melting objects, at the start
     std::vector<std::uint8_t> ring_;           // host, per IBP slot: one-ring neighbours still in it
+    int full_ring_ = 26;                       // a vertex's one-ring neighbours: 26, or 8 in 2D
     std::vector<LatticeIndex> grids_;  // host, per melting object: its lattice's grid
 };
 

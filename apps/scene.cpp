@@ -398,7 +398,6 @@ void check_object_in_plane(Section& s, const SceneObject& o, const char* kind) {
     if (o.kind == SolidKind::kStatic || o.kind == SolidKind::kCloth)
         s.fail(s.key_path("kind"), std::string("a 2D scene's objects are elastic, rigid or rod (this one is ") + kind +
                                        "; a static obstacle in 2D is a static_boxes entry)");
-    if (o.melts()) s.fail(s.key_path("melting_point"), "melting is not available in 2D scenes");
     const auto in_plane = [&](const char* key, Vec3 v) {
         if (v.z != 0) s.fail(s.key_path(key), describe_point(v) + ": a 2D scene lies in the plane z = 0; give [x, y]");
     };

@@ -492,9 +492,10 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
         const std::vector<std::uint8_t> ring = lattice_one_ring_counts(lattice);
         for (std::size_t k = 0; k < sample.ibp.count(); ++k) {
             const Vec3 x = to_vec3(sample.ibp.positions[k]);
-            solid.ibp.push_back(push(x, ring[k] < kFullOneRing ? kSurfaceBoundary : kInnerBoundary));
+            solid.ibp.push_back(push(x, ring[k] < full_one_ring(setup.params.dimensions) ? kSurfaceBoundary : kInnerBoundary));
             solid.lattice.push_back(lattice[k]);
             solid.pinned.push_back(pinned && pinned(x) ? 1 : 0);
+            if (outline) solid.ibp_mass.push_back(Real(double(solid.density) * r0 * r0));
         }
         solid.triangles.clear();
         solid.gp_offsets.assign(1, 0);
