@@ -19,8 +19,11 @@ class NeighborSearch final : public Module {
         : state_(state), grid_(state.device), lists_(state.device), arriving_(arriving) {
         const SimulationParams& params = state.params;
         const Real h = state.fluid.kernel.h;
-        grid_.configure(Vec3{lo.x - h, lo.y - h, lo.z - h}, Vec3{hi.x + h, hi.y + h, hi.z + h}, h, params.neighbors.ordering,
-                        params.neighbors.cells_per_support);
+        // In 2D everything lies in the plane z = lo.z = hi.z: one layer of cells, so that a
+        // particle's neighbourhood is 3 x 3 cells (and its Z-order a 2D one), not 3 x 3 x 2.
+        const Real hz = Kernel::kDimensions == 2 ? Real(0) : h;
+        grid_.configure(Vec3{lo.x - h, lo.y - h, lo.z - hz}, Vec3{hi.x + h, hi.y + h, hi.z + hz}, h,
+                        params.neighbors.ordering, params.neighbors.cells_per_support);
         use_lists_ = state.has_fluid && (params.neighbors.lists == NeighborParams::Lists::kAuto
                                              ? kPrefersNeighborLists
                                              : params.neighbors.lists == NeighborParams::Lists::kOn);

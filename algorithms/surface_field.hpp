@@ -127,21 +127,22 @@ double surface_iso_value(const Kernel& kernel, double spacing) {
             total += sum / lattice_sum;
         }
         return total / kPlaces;
+    } else {
+        for (int a = 0; a < kPlaces; ++a)
+            for (int b = 0; b < kPlaces; ++b) {
+                const double px = spacing * (a + 0.5) / kPlaces, py = spacing * (b + 0.5) / kPlaces, pz = 0.5 * spacing;
+                double sum = 0;
+                for (int k = -reach; k <= 0; ++k)
+                    for (int j = -reach; j <= reach; ++j)
+                        for (int i = -reach; i <= reach; ++i) {
+                            const double dx = px - i * spacing, dy = py - j * spacing, dz = pz - k * spacing;
+                            const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
+                            if (r < kernel.h) sum += kernel.W(Real(r));
+                        }
+                total += sum / lattice_sum;
+            }
+        return total / (kPlaces * kPlaces);
     }
-    for (int a = 0; a < kPlaces; ++a)
-        for (int b = 0; b < kPlaces; ++b) {
-            const double px = spacing * (a + 0.5) / kPlaces, py = spacing * (b + 0.5) / kPlaces, pz = 0.5 * spacing;
-            double sum = 0;
-            for (int k = -reach; k <= 0; ++k)
-                for (int j = -reach; j <= reach; ++j)
-                    for (int i = -reach; i <= reach; ++i) {
-                        const double dx = px - i * spacing, dy = py - j * spacing, dz = pz - k * spacing;
-                        const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
-                        if (r < kernel.h) sum += kernel.W(Real(r));
-                    }
-            total += sum / lattice_sum;
-        }
-    return total / (kPlaces * kPlaces);
 }
 
 }  // namespace mw
