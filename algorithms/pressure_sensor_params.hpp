@@ -18,7 +18,7 @@ inline const ParamTable<PressureSensorParams>& pressure_sensor_keys() {
                                   "the patch's centre, on a face of the domain (within r0/2 of it)")
                         .must_be_given());
         t.push_back(number_key<T>("pressure_sensors[]", "size", member(&T::size), ParamRange::positive(), "m",
-                                  "the square patch's side: the load on it over its area is the reading")
+                                  "the square patch's side (in 2D the segment's length): the load on it over its area is the reading")
                         .derive_default([](const ResolvedKeys& r) { return ParamValue::of(2 * r.number("fluid.spacing")); },
                                         "2 fluid.spacing"));
         return t;

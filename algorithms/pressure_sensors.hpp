@@ -70,7 +70,10 @@ class PressureSensors final : public Module {
         device_load_.resize(particle.size());
         device_reading_.resize(sensors_.size());
         area_.clear();
-        for (const PressureSensorSetup& sensor : sensors_) area_.push_back(double(sensor.size) * double(sensor.size));
+        // In 2D a patch is a segment of a wall's line, and the load one per unit depth.
+        const bool plane = state_.params.dimensions == 2;
+        for (const PressureSensorSetup& sensor : sensors_)
+            area_.push_back(plane ? double(sensor.size) : double(sensor.size) * double(sensor.size));
     }
 
     std::size_t bytes() const override {

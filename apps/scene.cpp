@@ -290,10 +290,6 @@ void read_root(Section& root, Scene& scene) {
     }
     root.resolved().dimensions = scene.params.dimensions;
     root.record("dimensions", scene.params.dimensions);
-    // What 2D scenes do not hold yet (the resolved scene writes it as an empty array).
-    if (scene.params.dimensions == 2)
-        if (const SceneJson* v = root.find("pressure_sensors"); v && !(v->is_array() && v->empty()))
-            root.fail("pressure_sensors", "not available in 2D scenes yet");
     root.read(scene_keys(), scene);
     // The name becomes the default output directory results/<name>: no path separators or dots
     // that would lead elsewhere, nothing a shell or a terminal would mangle.
@@ -486,7 +482,7 @@ void read_emitters(Section& root, Scene& scene) {
 }
 
 // A sensor sits on the domain face nearest its centre, within r0/2 of it, and its patch lies
-// within that face.
+// within that face; in 2D the faces are the domain's four sides, the patch a segment of one.
 void read_pressure_sensors(Section& root, Scene& scene) {
     root.array_of_objects("pressure_sensors", [&](Section& s, int index) {
         if (index >= 64) s.fail(s.path(), "at most 64 pressure sensors are supported");
@@ -496,8 +492,9 @@ void read_pressure_sensors(Section& root, Scene& scene) {
         const Vec3 lo = scene.params.domain_min, hi = scene.params.domain_max;
         const double c[3] = {p.center.x, p.center.y, p.center.z}, low[3] = {lo.x, lo.y, lo.z},
                      high[3] = {hi.x, hi.y, hi.z};
+        const int axes = scene.params.dimensions;
         double nearest = 1e300;
-        for (int a = 0; a < 3; ++a)
+        for (int a = 0; a < axes; ++a)
             for (int side : {-1, 1}) {
                 const double distance = std::abs(c[a] - (side < 0 ? low[a] : high[a]));
                 if (distance < nearest) {
@@ -512,7 +509,7 @@ void read_pressure_sensors(Section& root, Scene& scene) {
                                              " (within r0/2 of it): " + describe_point(p.center) + " is " +
                                              format_scene_number(nearest) + " m from the nearest");
         const double half = 0.5 * double(p.size);
-        for (int a = 0; a < 3; ++a)
+        for (int a = 0; a < axes; ++a)
             if (a != p.axis && (c[a] - half < low[a] - 1e-9 || c[a] + half > high[a] + 1e-9))
                 s.fail(s.key_path("size"), "the patch (centre " + describe_point(p.center) + ", side " +
                                                format_scene_number(double(p.size)) + ") reaches past its face of the domain " +

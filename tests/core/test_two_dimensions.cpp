@@ -1,13 +1,16 @@
 // What is particular to the plane: a 2D scene's boundaries have no faces normal to z. A 2D dam
 // break strikes a static box standing on the floor (its outline sampled as in 3D); the walls' and
 // the box's velocity–position correction must hold the fluid at its band in the plane without
-// ever pushing a particle off it. (The fluid alone in 2D: test_hydrostatic.cpp, test_dam_break.cpp.)
+// ever pushing a particle off it; pressure sensors on a 2D pool's floor and side read the water's weight.
+// (The fluid alone in 2D: test_hydrostatic.cpp, test_dam_break.cpp.)
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
+#include "algorithms/pcisph_delta.hpp"
+#include "algorithms/sph_kernels.hpp"
 #include "algorithms/wall_contact.hpp"
 #include "apps/scene.hpp"
 #include "apps/scene_builder.hpp"
@@ -81,4 +84,56 @@ TEST_CASE("2D: a dam break against a static box keeps its fluid at the box's ban
     // (measured 0.606 r0).
     CHECK(with.closest > 0.9 * band);
     CHECK(without.closest < 0.9 * band);
+}
+
+namespace {
+// A 2D pool 0.4 m wide and 0.3 m deep at r0 0.02 m, μ 0.05 Pa·s, CFL steps up to 2 ms, with a
+// sensor on the floor's middle (0.08 m) and two on the left wall (0.04 m) 0.15 and 0.25 m deep.
+const char* kPool2d = R"({
+  "name": "pool_2d", "dimensions": 2,
+  "domain": { "min": [0, 0], "max": [0.4, 0.4] },
+  "fluid": { "spacing": 0.02, "viscosity": 0.05 },
+  "solver": { "dt": 0.002, "dt_mode": "cfl" },
+  "fluid_blocks": [ { "min": [0, 0], "max": [0.4, 0.3] } ],
+  "pressure_sensors": [ { "name": "floor", "center": [0.2, 0], "size": 0.08 },
+                        { "name": "wall_15", "center": [0, 0.15], "size": 0.04 },
+                        { "name": "wall_05", "center": [0, 0.05], "size": 0.04 } ]
+})";
+}  // namespace
+
+TEST_CASE("2D: pressure sensors on the floor and a side wall read the weight of the water above them") {
+    const SimulationSetup setup = build_setup(parse_scene_text(kPool2d, "pool_2d.json"));
+    REQUIRE(setup.pressure_sensors.size() == 3);
+    auto sim = create_openmp_simulation(setup, 1);
+    const double g = 9.81, width = 0.4;
+    // A particle's mass per unit depth: ρ0 over the 2D prototype lattice's Σ W (pcisph_delta.hpp).
+    const double mass = with_kernel(KernelKind::kCubicSpline, 2, setup.params.fluid.support_radius, [&](const auto& kernel) {
+        return double(setup.params.fluid.rest_density) / prototype_sums(kernel, 0.02, 2).sum_W;
+    });
+    double floor = 0, wall_15 = 0, wall_05 = 0, above_15 = 0, above_05 = 0, fluid_weight = 0;
+    long steps = 0;
+    HostParticles p;
+    while (sim->time() < 1.2) {
+        sim->step();
+        if (sim->time() < 0.8) continue;
+        const StepReport& r = sim->last_report();
+        floor += r.value("sensor_floor"), wall_15 += r.value("sensor_wall_15"), wall_05 += r.value("sensor_wall_05");
+        // The weight per unit length of the water above each wall sensor's centre, and of all of it.
+        sim->download(p);
+        for (std::size_t i = 0; i < p.position.size(); ++i) {
+            if (p.type[i] != kFluid) continue;
+            fluid_weight += mass * g / width;
+            if (p.position[i].y > 0.15) above_15 += mass * g / width;
+            if (p.position[i].y > 0.05) above_05 += mass * g / width;
+        }
+        ++steps;
+    }
+    REQUIRE(steps > 50);
+    floor /= double(steps), wall_15 /= double(steps), wall_05 /= double(steps);
+    fluid_weight /= double(steps), above_15 /= double(steps), above_05 /= double(steps);
+    MESSAGE("2D sensors over the weight above them: floor " << floor / fluid_weight << ", wall 0.15 m deep "
+                                                            << wall_15 / above_15 << ", 0.25 m deep " << wall_05 / above_05);
+    CHECK(floor / fluid_weight == doctest::Approx(1).epsilon(0.03));
+    CHECK(wall_15 / above_15 == doctest::Approx(1).epsilon(0.05));
+    CHECK(wall_05 / above_05 == doctest::Approx(1).epsilon(0.05));
 }
