@@ -95,12 +95,15 @@ TriangleMesh load_frame_obj(const std::string& path) {
     std::ifstream in(path);
     if (!in) throw InputError(path + ": cannot be read");
     std::vector<std::string> lines;
-    int edges = 0;
+    int edges = 0, vertices = 0;
     for (std::string line; std::getline(in, line);) {
         if (line.rfind("f ", 0) == 0) return load_obj(path, false);
         edges += line.rfind("l ", 0) == 0;
+        vertices += line.rfind("v ", 0) == 0;
         lines.push_back(std::move(line));
     }
+    // A frame without fluid writes a surface with no vertex: nothing to draw.
+    if (vertices == 0) return TriangleMesh{};
     if (edges < 2) return load_obj(path, false);
     TriangleMesh outline;
     outline.source = path;

@@ -85,6 +85,26 @@ TEST_CASE("render: a finished run's frames drawn again are the pictures the run 
     CHECK(fs::exists(dir + "/quiet/preview_00001.png"));
 }
 
+TEST_CASE("render: a frame with no fluid yet, its surface empty, is drawn") {
+    // The only fluid comes from an emitter that starts after the frames: each surface OBJ holds no
+    // vertex, which render reads as nothing to draw.
+    const std::string scene = scene_file("pictures_no_fluid.json", R"({
+  "name": "no_fluid", "domain": { "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] }, "fluid": { "spacing": 0.02 },
+  "solver": { "dt": 0.002 },
+  "emitters": [ { "center": [0.1, 0.15, 0.1], "direction": [0, -1, 0], "radius": 0.04, "speed": 1, "start": 1, "end": 2 } ]
+})");
+    const std::string dir = out_dir("pictures_no_fluid");
+    const Result r = run("run " + scene + " --time 0.02 --quiet --out " + dir +
+                         " --set output.fps=100 --set 'output.formats=[\"vtu\",\"surface\"]'");
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    REQUIRE(fs::exists(dir + "/frames/surface_00001.obj"));
+    const Result again = run("render " + dir + " --out " + dir + "/again");
+    CAPTURE(again.err);
+    CHECK(again.code == 0);
+    CHECK(fs::exists(dir + "/again/preview_00001.png"));
+}
+
 TEST_CASE("render: a rod's frames are drawn as the run drew them, a tube round its line") {
     // A rod alone, filling the picture: its frame OBJs hold its line (one "l"), which render reads
     // back in the line's order and draws as the run's preview does.
