@@ -80,7 +80,7 @@ VtuFrame read_vtu(const std::string& path) {
         const char* data = text.data() + base + a.offset + 8;
         if (a.is_points) {
             std::vector<float> xyz(count);
-            std::memcpy(xyz.data(), data, bytes);
+            if (bytes > 0) std::memcpy(xyz.data(), data, bytes);  // a frame of no particle: no data to copy
             frame.points.resize(n);
             for (std::uint64_t i = 0; i < n; ++i) frame.points[i] = Vec3{Real(xyz[3 * i]), Real(xyz[3 * i + 1]), Real(xyz[3 * i + 2])};
             continue;
@@ -88,9 +88,14 @@ VtuFrame read_vtu(const std::string& path) {
         VtuArray out;
         out.name = a.name;
         out.components = a.components;
-        if (a.type == "Float32") out.floats.resize(count), std::memcpy(out.floats.data(), data, bytes);
-        else if (a.type == "Int32") out.ints.resize(count), std::memcpy(out.ints.data(), data, bytes);
-        else out.bytes.resize(count), std::memcpy(out.bytes.data(), data, bytes);
+        // An empty array's data() may be null, which memcpy must not be given even for 0 bytes.
+        if (a.type == "Float32") out.floats.resize(count);
+        else if (a.type == "Int32") out.ints.resize(count);
+        else out.bytes.resize(count);
+        void* to = a.type == "Float32" ? static_cast<void*>(out.floats.data())
+                   : a.type == "Int32" ? static_cast<void*>(out.ints.data())
+                                       : static_cast<void*>(out.bytes.data());
+        if (bytes > 0) std::memcpy(to, data, bytes);
         frame.arrays.push_back(std::move(out));
     }
     if (frame.points.size() != n) throw refuse("no points array");
