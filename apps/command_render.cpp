@@ -94,37 +94,15 @@ HostParticles frame_particles(const std::string& path) {
 TriangleMesh load_frame_obj(const std::string& path) {
     std::ifstream in(path);
     if (!in) throw InputError(path + ": cannot be read");
-    std::vector<std::string> lines;
     int edges = 0, vertices = 0;
     for (std::string line; std::getline(in, line);) {
         if (line.rfind("f ", 0) == 0) return load_obj(path, false);
         edges += line.rfind("l ", 0) == 0;
         vertices += line.rfind("v ", 0) == 0;
-        lines.push_back(std::move(line));
     }
     // A frame without fluid writes a surface with no vertex: nothing to draw.
     if (vertices == 0) return TriangleMesh{};
-    if (edges < 2) return load_obj(path, false);
-    TriangleMesh outline;
-    outline.source = path;
-    for (std::size_t k = 0; k < lines.size(); ++k) {
-        std::istringstream fields(lines[k]);
-        std::string tag, rest;
-        fields >> tag;
-        double x = 0, y = 0, z = 0;
-        long a = 0, b = 0;
-        if (tag == "v" && (fields >> x >> y >> z) && !(fields >> rest)) {
-            outline.vertices.emplace_back(x, y, z);
-        } else if (tag == "l" && (fields >> a >> b) && !(fields >> rest) && a >= 1 && b >= 1 && a != b) {
-            outline.triangles.push_back({int(a - 1), int(b - 1), int(a - 1)});
-        } else if (!tag.empty() && tag[0] != '#') {
-            throw InputError(path + ":" + std::to_string(k + 1) + ": expected \"v x y z\" or \"l a b\" in an outline's OBJ");
-        }
-    }
-    for (const auto& t : outline.triangles)
-        if (std::size_t(std::max(t[0], t[1])) >= outline.vertices.size())
-            throw InputError(path + ": an edge names a vertex past the " + std::to_string(outline.vertices.size()) + " given");
-    return outline;
+    return edges < 2 ? load_obj(path, false) : load_obj_edges(path);
 }
 
 // The meshes written with frame `number`: each object's, then the fluid's surface. A rod's OBJ is

@@ -290,6 +290,35 @@ TriangleMesh load_obj(const std::string& path, bool require_volume) {
     return parse_obj(text.str(), path, require_volume);
 }
 
+TriangleMesh load_obj_edges(const std::string& path) {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw InputError(path + ": OBJ file cannot be read");
+    std::ostringstream text;
+    text << probe.rdbuf();
+    tinyobj::ObjReader reader;
+    reader.ParseFromString(text.str(), std::string(), config());
+    if (!reader.Valid()) throw InputError(path + ": cannot parse OBJ (" + first_line(reader.Error()) + ")");
+    const std::vector<tinyobj::real_t>& v = reader.GetAttrib().vertices;
+    TriangleMesh outline;
+    outline.source = path;
+    for (std::size_t k = 0; k + 2 < v.size(); k += 3) outline.vertices.emplace_back(v[k], v[k + 1], v[k + 2]);
+    for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+        if (!shape.mesh.indices.empty()) throw InputError(path + ": holds faces, not an outline's edges");
+        std::size_t at = 0;
+        for (const int points : shape.lines.num_line_vertices) {
+            for (int p = 0; p + 1 < points; ++p) {
+                const int a = shape.lines.indices[at + std::size_t(p)].vertex_index;
+                const int b = shape.lines.indices[at + std::size_t(p) + 1].vertex_index;
+                if (a < 0 || b < 0 || std::size_t(std::max(a, b)) >= outline.vertices.size())
+                    throw InputError(path + ": a line names a vertex past the " + std::to_string(outline.vertices.size()) + " given");
+                if (a != b) outline.triangles.push_back({a, b, a});
+            }
+            at += std::size_t(points);
+        }
+    }
+    return outline;
+}
+
 TriangleMesh parse_obj(const std::string& text, const std::string& source, bool require_volume) {
     std::vector<int> polyline;
     const std::string checked = checked_obj_text(text, source, polyline);

@@ -227,3 +227,31 @@ TEST_CASE("the shared meshes load with the expected topology") {
     CHECK(edge_report(bunny).boundary_edges == 223);
     CHECK(signed_volume(bunny) == doctest::Approx(7.70e-4).epsilon(0.01));
 }
+
+TEST_CASE("OBJ edges: line elements read as an outline's edges, and what is not one is refused naming the file") {
+    const auto write = [](const std::string& name, const std::string& text) {
+        const std::string path = (scratch_dir() / name).string();
+        std::ofstream(path) << text;
+        return path;
+    };
+    // Two "l a b" edges and one line of three points: four edges, each (a, b, a).
+    const mw::TriangleMesh m = mw::load_obj_edges(write("edges.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nl 1 2\nl 2 3\nl 3 4 1\n"));
+    REQUIRE(m.vertices.size() == 4);
+    REQUIRE(m.triangles.size() == 4);
+    CHECK(m.triangles[2] == std::array<int, 3>{2, 3, 2});
+    CHECK(m.triangles[3] == std::array<int, 3>{3, 0, 3});
+    CHECK(mw::load_obj_edges(write("empty.obj", "# no fluid\n")).triangles.empty());
+    for (const auto& [name, text, part] : {std::tuple<std::string, std::string, std::string>{"faces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "holds faces"},
+                                          {"past.obj", "v 0 0 0\nv 1 0 0\nl 1 5\n", "past the 2"}}) {
+        CAPTURE(name);
+        const std::string path = write(name, text);
+        try {
+            mw::load_obj_edges(path);
+            FAIL("accepted");
+        } catch (const mw::InputError& e) {
+            CHECK(std::string(e.what()).find(path) != std::string::npos);
+            CHECK(std::string(e.what()).find(part) != std::string::npos);
+        }
+    }
+    CHECK_THROWS_AS(mw::load_obj_edges((scratch_dir() / "missing.obj").string()), mw::InputError);
+}
