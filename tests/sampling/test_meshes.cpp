@@ -241,10 +241,12 @@ TEST_CASE("OBJ edges: line elements read as an outline's edges, and what is not 
     CHECK(m.triangles[2] == std::array<int, 3>{2, 3, 2});
     CHECK(m.triangles[3] == std::array<int, 3>{3, 0, 3});
     CHECK(mw::load_obj_edges(write("empty.obj", "# no fluid\n")).triangles.empty());
-    for (const auto& [name, text, part] : {std::tuple<std::string, std::string, std::string>{"faces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "holds faces"},
-                                          {"past.obj", "v 0 0 0\nv 1 0 0\nl 1 5\n", "past the 2"}}) {
+    for (const auto& refused : {std::tuple<std::string, std::string, std::string>{"faces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "holds faces"},
+                                 {"past.obj", "v 0 0 0\nv 1 0 0\nl 1 5\n", "past the 2"}}) {
+        // Named copies: CAPTURE's lambda cannot capture a structured binding under clang 14.
+        const std::string name = std::get<0>(refused), part = std::get<2>(refused);
         CAPTURE(name);
-        const std::string path = write(name, text);
+        const std::string path = write(name, std::get<1>(refused));
         try {
             mw::load_obj_edges(path);
             FAIL("accepted");
