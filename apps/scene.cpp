@@ -388,12 +388,11 @@ void read_object_pinned(Section s, SceneObject& o, int dimensions) {
 }
 
 // A 2D object is an outline in the plane z = 0 (or a rod's line there), moved and turned in it:
-// elastic, rigid or rod. Static objects stop the fluid by a 3D distance field, cloth is a
-// surface, and melting builds its surface from the 26 neighbours of a 3D lattice.
+// elastic, rigid, static or rod. A cloth is a surface: the plane's sheet is a rod.
 void check_object_in_plane(Section& s, const SceneObject& o, const char* kind) {
-    if (o.kind == SolidKind::kStatic || o.kind == SolidKind::kCloth)
-        s.fail(s.key_path("kind"), std::string("a 2D scene's objects are elastic, rigid or rod (this one is ") + kind +
-                                       "; a static obstacle in 2D is a static_boxes entry)");
+    if (o.kind == SolidKind::kCloth)
+        s.fail(s.key_path("kind"), std::string("a 2D scene's objects are elastic, rigid, static or rod (this one is ") +
+                                       kind + "; a rod is the plane's sheet)");
     const auto in_plane = [&](const char* key, Vec3 v) {
         if (v.z != 0) s.fail(s.key_path(key), describe_point(v) + ": a 2D scene lies in the plane z = 0; give [x, y]");
     };

@@ -15,6 +15,7 @@
 #include "sampling/obj_loader.hpp"
 #include "sampling/outline.hpp"
 #include "sampling/outline_sample.hpp"
+#include "sampling/outline_distance.hpp"
 #include "sampling/procedural_meshes.hpp"
 #include "sampling/signed_distance.hpp"
 #include "sampling/rod_sample.hpp"
@@ -646,7 +647,9 @@ std::size_t add_rod_object(SimulationSetup& setup, const TriangleMesh& line, Sol
 
 bool add_static_object_distance(SimulationSetup& setup, const TriangleMesh& mesh, double r0, const SealedFace& sealed) {
     const double contact = kStaticObjectContact * r0;
-    const SignedDistanceGrid sdf = signed_distance_grid(mesh, r0 / 2, contact, kMaxObjectDistanceNodes, sealed);
+    const SignedDistanceGrid sdf = setup.params.dimensions == 2
+                                       ? signed_distance_outline(mesh, r0 / 2, contact, kMaxObjectDistanceNodes, sealed)
+                                       : signed_distance_grid(mesh, r0 / 2, contact, kMaxObjectDistanceNodes, sealed);
     if (sdf.exit_triangles == 0) return false;
     std::vector<Real>& values = setup.params.boundary.static_object_distances;
     if (values.size() + sdf.distance.size() > std::size_t(UINT32_MAX))
@@ -668,6 +671,7 @@ SealedFace sealed_faces(const Scene& scene) {
     // A thousandth of r0: a face meant to stand on the floor or a box lies there to rounding.
     const double tolerance = 1e-3 * double(scene.params.fluid.spacing);
     const bool walls = scene.walls();
+    const int axes = scene.params.dimensions;  // a 2D domain is flat in z, and has no walls there
     const Vec3d lo(scene.params.domain_min.x, scene.params.domain_min.y, scene.params.domain_min.z);
     const Vec3d hi(scene.params.domain_max.x, scene.params.domain_max.y, scene.params.domain_max.z);
     std::vector<Eigen::AlignedBox3d> boxes;
@@ -675,7 +679,7 @@ SealedFace sealed_faces(const Scene& scene) {
         boxes.emplace_back(Vec3d(b.min.x, b.min.y, b.min.z) - Vec3d::Constant(tolerance),
                            Vec3d(b.max.x, b.max.y, b.max.z) + Vec3d::Constant(tolerance));
     return [=](const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-        for (int axis = 0; walls && axis < 3; ++axis) {
+        for (int axis = 0; walls && axis < axes; ++axis) {
             if (std::max({a[axis], b[axis], c[axis]}) <= lo[axis] + tolerance) return true;
             if (std::min({a[axis], b[axis], c[axis]}) >= hi[axis] - tolerance) return true;
         }
