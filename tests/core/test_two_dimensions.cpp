@@ -1,7 +1,8 @@
 // What is particular to the plane: a 2D scene's boundaries have no faces normal to z. A 2D dam
-// break strikes a static box standing on the floor (its outline sampled as in 3D); the walls' and
-// the box's velocity–position correction must hold the fluid at its band in the plane without
-// ever pushing a particle off it; pressure sensors on a 2D pool's floor and side read the water's weight.
+// break strikes a static box standing on the floor (its outline sampled as in 3D), and static
+// objects (a disc, a thin plate) held off the floor; the walls', the box's and the objects'
+// velocity–position correction must hold the fluid at its band in the plane without ever pushing
+// a particle off it; pressure sensors on a 2D pool's floor and side read the water's weight.
 // (The fluid alone in 2D: test_hydrostatic.cpp, test_dam_break.cpp.)
 #include <doctest/doctest.h>
 
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <utility>
 
 #include "algorithms/pcisph_delta.hpp"
 #include "algorithms/sph_kernels.hpp"
@@ -20,11 +22,47 @@
 using namespace mw;
 
 namespace {
-// A 0.4 x 0.8 m column at r0 0.02 m collapsing onto a 0.2 m square box 0.5 m downstream, CFL steps
-// as the scenes run them.
-std::string dam_against_box(bool correction) {
+// A 0.4 x 0.8 m column at r0 0.02 m collapsing onto an obstacle downstream, CFL steps as the
+// scenes run them. The obstacle: the scene's entry for it and its signed distance (negative
+// inside); a fluid centre at or below `inside_at` counts as inside.
+struct Obstacle {
+    std::string entry;
+    std::function<double(double, double)> distance;
+    double inside_at = 0;
+};
+
+// The signed distance to the rectangle [x0, x1] x [y0, y1].
+double rectangle_distance(double x, double y, double x0, double x1, double y0, double y1) {
+    const double dx = std::max(x0 - x, x - x1), dy = std::max(y0 - y, y - y1);
+    return dx < 0 && dy < 0 ? std::max(dx, dy) : std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
+}
+
+// A 0.2 m square static box on the floor, 0.5 m downstream.
+Obstacle static_box() {
+    return {R"("static_boxes": [ { "min": [0.9, 0], "max": [1.1, 0.2] } ])",
+            [](double x, double y) { return rectangle_distance(x, y, 0.9, 1.1, 0.0, 0.2); }};
+}
+
+// Static objects 1 m downstream, 0.1-0.4 m above the floor, so that the surge runs under and
+// over them: a disc of radius 0.1 m (its outline a 64-gon, whose flats lie 0.0012 of the radius
+// inside the circle) centred 0.25 m up, or a plate one r0 thick and 0.3 m tall.
+Obstacle static_object(const std::string& procedural, std::function<double(double, double)> distance, double inside_at) {
+    return {R"("objects": [ { "name": "obstacle", "kind": "static", "mesh": { "procedural": ")" + procedural +
+                R"(" }, "transform": { "translation": [1.0, 0.25] } } ])",
+            std::move(distance), inside_at};
+}
+Obstacle disc() {
+    return static_object("circle:radius=0.1", [](double x, double y) { return std::hypot(x - 1.0, y - 0.25) - 0.1; },
+                         -0.0012 * 0.1);
+}
+Obstacle plate() {
+    return static_object("rectangle:x=0.02,y=0.3",
+                         [](double x, double y) { return rectangle_distance(x, y, 0.99, 1.01, 0.1, 0.4); }, 0);
+}
+
+std::string dam_against(const Obstacle& obstacle, bool correction) {
     return std::string(R"({
-  "name": "dam_box_2d",
+  "name": "dam_obstacle_2d",
   "dimensions": 2,
   "domain": { "min": [0, 0], "max": [1.6, 1.0] },
   "fluid": { "spacing": 0.02 },
@@ -32,20 +70,20 @@ std::string dam_against_box(bool correction) {
   "boundary": { "correction": )") +
            (correction ? "true" : "false") + R"( },
   "fluid_blocks": [ { "min": [0, 0], "max": [0.4, 0.8] } ],
-  "static_boxes": [ { "min": [0.9, 0], "max": [1.1, 0.2] } ]
+  )" + obstacle.entry + R"(
 })";
 }
 
-struct BoxRun {
-    double closest = 1e9;  // the closest fluid centre came to the box, m
+struct DamRun {
+    double closest = 1e9;  // the closest fluid centre came to the obstacle, m
     double largest_z = 0;
     long inside = 0, lost = 0;
 };
 
-BoxRun run_against_box(bool correction, double seconds) {
-    const SimulationSetup setup = build_setup(parse_scene_text(dam_against_box(correction), "dam_box_2d.json"));
+DamRun run_against(const Obstacle& obstacle, bool correction, double seconds) {
+    const SimulationSetup setup = build_setup(parse_scene_text(dam_against(obstacle, correction), "dam_obstacle_2d.json"));
     auto sim = create_openmp_simulation(setup, 1);
-    BoxRun out;
+    DamRun out;
     HostParticles p;
     while (sim->time() < seconds) {
         sim->step();
@@ -53,10 +91,9 @@ BoxRun run_against_box(bool correction, double seconds) {
         for (std::size_t i = 0; i < p.position.size(); ++i) {
             out.largest_z = std::max(out.largest_z, std::fabs(double(p.position[i].z)));
             if (p.type[i] != kFluid) continue;
-            const double x = p.position[i].x, y = p.position[i].y;
-            const double dx = x - std::clamp(x, 0.9, 1.1), dy = y - std::clamp(y, 0.0, 0.2);
-            out.closest = std::min(out.closest, std::sqrt(dx * dx + dy * dy));
-            out.inside += dx == 0 && dy == 0;
+            const double d = obstacle.distance(p.position[i].x, p.position[i].y);
+            out.closest = std::min(out.closest, d);
+            out.inside += d <= obstacle.inside_at;
         }
         out.lost = std::max(out.lost, sim->last_report().lost_particles);
     }
@@ -66,11 +103,11 @@ BoxRun run_against_box(bool correction, double seconds) {
 
 TEST_CASE("2D: a dam break against a static box keeps its fluid at the box's band and in the plane") {
     const double r0 = 0.02;
-    const SimulationSetup setup = build_setup(parse_scene_text(dam_against_box(true), "dam_box_2d.json"));
+    const SimulationSetup setup = build_setup(parse_scene_text(dam_against(static_box(), true), "dam_obstacle_2d.json"));
     REQUIRE(setup.params.boundary.static_boxes.size() == 1);
     const double band = contact_box(setup.params.boundary.static_boxes[0], Real(r0), 2).contact;
-    const BoxRun with = run_against_box(true, 1.5);
-    const BoxRun without = run_against_box(false, 1.5);
+    const DamRun with = run_against(static_box(), true, 1.5);
+    const DamRun without = run_against(static_box(), false, 1.5);
     MESSAGE("closest fluid centre to the box: " << with.closest / r0 << " r0 with the correction (band "
                                                 << band / r0 << " r0), " << without.closest / r0 << " r0 without");
     CHECK(with.inside == 0);
@@ -87,74 +124,21 @@ TEST_CASE("2D: a dam break against a static box keeps its fluid at the box's ban
     CHECK(without.closest < 0.9 * band);
 }
 
-namespace {
-// The same dam against a static object 1 m downstream, 0.1-0.4 m above the floor, so that the
-// surge runs under and over it: a disc of radius 0.1 m (its outline a 64-gon) centred 0.25 m up,
-// or a plate one r0 thick and 0.3 m tall. `distance`: the signed distance to the object.
-struct StaticShape {
-    const char* procedural;
-    std::function<double(double, double)> distance;
-};
-StaticShape disc() {
-    return {"circle:radius=0.1", [](double x, double y) { return std::hypot(x - 1.0, y - 0.25) - 0.1; }};
-}
-StaticShape plate() {
-    return {"rectangle:x=0.02,y=0.3", [](double x, double y) {
-                const double dx = std::fabs(x - 1.0) - 0.01, dy = std::fabs(y - 0.25) - 0.15;
-                return dx < 0 && dy < 0 ? std::max(dx, dy) : std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
-            }};
-}
-std::string dam_against_object(const StaticShape& shape, bool correction) {
-    return std::string(R"({
-  "name": "dam_object_2d",
-  "dimensions": 2,
-  "domain": { "min": [0, 0], "max": [1.6, 1.0] },
-  "fluid": { "spacing": 0.02 },
-  "solver": { "dt": 0.002, "dt_mode": "cfl" },
-  "boundary": { "correction": )") +
-           (correction ? "true" : "false") + R"( },
-  "fluid_blocks": [ { "min": [0, 0], "max": [0.4, 0.8] } ],
-  "objects": [ { "name": "obstacle", "kind": "static", "mesh": { "procedural": ")" + shape.procedural + R"(" },
-                 "transform": { "translation": [1.0, 0.25] } } ]
-})";
-}
-
-BoxRun run_against_object(const StaticShape& shape, bool correction, double seconds) {
-    const SimulationSetup setup = build_setup(parse_scene_text(dam_against_object(shape, correction), "dam_object_2d.json"));
-    auto sim = create_openmp_simulation(setup, 1);
-    BoxRun out;
-    HostParticles p;
-    while (sim->time() < seconds) {
-        sim->step();
-        sim->download(p);
-        for (std::size_t i = 0; i < p.position.size(); ++i) {
-            out.largest_z = std::max(out.largest_z, std::fabs(double(p.position[i].z)));
-            if (p.type[i] != kFluid) continue;
-            const double d = shape.distance(p.position[i].x, p.position[i].y);
-            out.closest = std::min(out.closest, d);
-            out.inside += d < -0.0012 * 0.1;  // the 64-gon's flats lie 0.0012 of the radius inside the circle
-        }
-        out.lost = std::max(out.lost, sim->last_report().lost_particles);
-    }
-    return out;
-}
-}  // namespace
-
 TEST_CASE("2D: a dam break against static objects keeps its fluid at their band and in the plane") {
     const double r0 = 0.02;
-    const SimulationSetup setup = build_setup(parse_scene_text(dam_against_object(disc(), true), "dam_object_2d.json"));
+    const SimulationSetup setup = build_setup(parse_scene_text(dam_against(disc(), true), "dam_obstacle_2d.json"));
     // The object's distance grid: two equal layers either side of the plane (sampling/outline_distance.hpp).
     REQUIRE(setup.params.boundary.static_objects.size() == 1);
     const ContactField& field = setup.params.boundary.static_objects[0];
     CHECK(field.field.nz == 2);
     const double band = kStaticObjectContact * r0;
-    const BoxRun round = run_against_object(disc(), true, 1.5);
-    const BoxRun thin = run_against_object(plate(), true, 1.5);
-    const BoxRun thin_without = run_against_object(plate(), false, 1.5);
+    const DamRun round = run_against(disc(), true, 1.5);
+    const DamRun thin = run_against(plate(), true, 1.5);
+    const DamRun thin_without = run_against(plate(), false, 1.5);
     MESSAGE("closest fluid centre: the disc " << round.closest / r0 << " r0, the plate " << thin.closest / r0
                                               << " r0 with the correction (band " << band / r0 << " r0), "
                                               << thin_without.closest / r0 << " r0 without");
-    for (const BoxRun* run : {&round, &thin, &thin_without}) {
+    for (const DamRun* run : {&round, &thin, &thin_without}) {
         CHECK(run->inside == 0);
         CHECK(run->lost == 0);
         CHECK(run->largest_z == 0);
