@@ -14,14 +14,6 @@ namespace mw {
 
 namespace {
 
-double point_segment_distance2_2d(double px, double py, const Vec3d& a, const Vec3d& b) {
-    const double ex = b.x() - a.x(), ey = b.y() - a.y();
-    const double length2 = ex * ex + ey * ey;
-    const double t = length2 > 0 ? std::clamp(((px - a.x()) * ex + (py - a.y()) * ey) / length2, 0.0, 1.0) : 0.0;
-    const double dx = px - (a.x() + t * ex), dy = py - (a.y() + t * ey);
-    return dx * dx + dy * dy;
-}
-
 // Nodes along x and y covering [lo - margin, hi + margin] at `spacing`, centred on the box; two
 // along z, at -spacing/2 and +spacing/2.
 LatticeGrid covering_plane_grid(const Aabb& box, double spacing, double margin) {
@@ -55,13 +47,7 @@ SignedDistanceGrid signed_distance_outline(const TriangleMesh& outline, double s
     result.exit_triangles = exits.size();
     if (exits.empty()) return result;
 
-    Aabb box;
-    box.lo = box.hi = outline.vertices[std::size_t(edges.front()[0])];
-    for (const auto& e : edges)
-        for (int k = 0; k < 2; ++k) {
-            box.lo = box.lo.cwiseMin(outline.vertices[std::size_t(e[k])]);
-            box.hi = box.hi.cwiseMax(outline.vertices[std::size_t(e[k])]);
-        }
+    const Aabb box = bounding_box(outline);
     result.grid = covering_plane_grid(box, spacing, band + 2 * spacing);
     if (max_nodes > 0 && result.grid.count() > max_nodes) {
         // The smallest spacing whose grid fits: the extents over the node budget's square root
@@ -76,12 +62,14 @@ SignedDistanceGrid signed_distance_outline(const TriangleMesh& outline, double s
 #pragma omp parallel for schedule(static)
     for (long id = 0; id < static_cast<long>(layer); ++id) {
         const std::size_t u = std::size_t(id);
-        const Vec3d p = grid.position(int(u % nx), int(u / nx), 0);
-        double best = std::numeric_limits<double>::infinity();
-        for (const auto& e : exits)
-            best = std::min(best, point_segment_distance2_2d(p.x(), p.y(), outline.vertices[std::size_t(e[0])],
-                                                             outline.vertices[std::size_t(e[1])]));
-        const double d = std::sqrt(best);
+        Vec3d p = grid.position(int(u % nx), int(u / nx), 0);
+        p.z() = 0;  // measured in the plane; both layers take the value
+        // An edge (a, b) is the degenerate triangle (a, b, a): the distance to its segment.
+        double d = std::numeric_limits<double>::infinity();
+        for (const auto& e : exits) {
+            const Vec3d& a = outline.vertices[std::size_t(e[0])];
+            d = std::min(d, point_triangle_distance(p, a, outline.vertices[std::size_t(e[1])], a));
+        }
         const double signed_d = inside_loops(outline.vertices, edges, p.x(), p.y()) ? -d : d;
         result.distance[u] = signed_d;
         result.distance[u + layer] = signed_d;
