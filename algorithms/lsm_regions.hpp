@@ -282,27 +282,51 @@ inline void append_region_chunks(LsmHostLayout& L, std::uint32_t region, std::si
 // kernel skips it.
 constexpr std::uint32_t kMeltedSlot = 0xffffffffu;
 
-namespace lsm_detail {
-// Region r's rest sums (mass, centre c0, A0 = Σ m̃ q qᵀ, inverse rest inertia) from its members'
-// rest positions and split masses, in double.
-inline void set_region_rest_sums(LsmHostLayout& L, std::size_t r, const std::uint32_t* members_begin,
-                                 const std::uint32_t* members_end) {
+// The region arrays as a rebuild after melting writes them (melting_regions.hpp), by slot: an
+// elastic region is centred on its IBP, so region and slot share an index.
+struct MeltingRegionArrays {
+    const Vec3* rest = nullptr;                  // per IBP slot
+    const Real* mass = nullptr;                  // per IBP slot: the IBP's whole mass
+    const std::uint32_t* region_offsets = nullptr;  // each region's place (its capacity: to the next)
+    const std::uint32_t* regions_begin = nullptr;   // per IBP slot: the first of its regions in member_index
+    std::uint32_t* region_end = nullptr;
+    std::uint32_t* regions_end = nullptr;
+    std::uint32_t* member_index = nullptr;
+    Real* split_mass = nullptr;
+    Real* region_mass = nullptr;
+    Vec3* region_c0 = nullptr;
+    SymMat3* region_A0 = nullptr;
+    SymMat3* region_inertia_inv = nullptr;
+};
+
+// A region's rest sums: its mass, centre c0, A0 = Σ m̃ q qᵀ and inverse rest inertia, from its
+// members' rest positions and split masses (both indexed by slot), in double. One function for the
+// host's build and the device's rebuild after melting (melting_regions.hpp), so that both give the
+// same bits.
+struct RegionRestSums {
+    Real mass = 0;
+    Vec3 c0{0, 0, 0};
+    SymMat3 A0{}, inertia_inv{};
+};
+MW_INLINE RegionRestSums region_rest_sums(const std::uint32_t* members_begin, const std::uint32_t* members_end,
+                                          const Real* split_mass, const Vec3* rest) {
     double M = 0, c[3] = {0, 0, 0};
     for (const std::uint32_t* it = members_begin; it != members_end; ++it) {
-        const double w = L.ibp_split_mass[*it];
-        const Vec3 x = L.ibp_rest[*it];
+        const double w = split_mass[*it];
+        const Vec3 x = rest[*it];
         M += w, c[0] += w * x.x, c[1] += w * x.y, c[2] += w * x.z;
     }
     if (M > 0) c[0] /= M, c[1] /= M, c[2] /= M;
     double a[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy xz yz
     for (const std::uint32_t* it = members_begin; it != members_end; ++it) {
-        const double w = L.ibp_split_mass[*it];
-        const Vec3 x = L.ibp_rest[*it];
+        const double w = split_mass[*it];
+        const Vec3 x = rest[*it];
         const double q[3] = {x.x - c[0], x.y - c[1], x.z - c[2]};
         a[0] += w * q[0] * q[0], a[1] += w * q[1] * q[1], a[2] += w * q[2] * q[2];
         a[3] += w * q[0] * q[1], a[4] += w * q[0] * q[2], a[5] += w * q[1] * q[2];
     }
-    L.region_mass[r] = Real(M);
+    RegionRestSums out;
+    out.mass = Real(M);
     // Nudge c0 (in Real) so that Σ m̃ (x0 - c0), evaluated in Real as the kernels do, is as
     // close to zero as rounding allows: the goals' momentum balance rests on that sum, and
     // its rounding error, divided by Δt, would otherwise show up as a slow drift of momentum.
@@ -310,16 +334,28 @@ inline void set_region_rest_sums(LsmHostLayout& L, std::size_t r, const std::uin
     for (int pass = 0; pass < 3 && M > 0; ++pass) {
         double e[3] = {0, 0, 0};
         for (const std::uint32_t* it = members_begin; it != members_end; ++it) {
-            const Vec3 q = L.ibp_rest[*it] - c0;
-            const double w = L.ibp_split_mass[*it];
+            const Vec3 q = rest[*it] - c0;
+            const double w = split_mass[*it];
             e[0] += w * double(q.x), e[1] += w * double(q.y), e[2] += w * double(q.z);
         }
         c0 = c0 + Vec3{Real(e[0] / M), Real(e[1] / M), Real(e[2] / M)};
     }
-    L.region_c0[r] = c0;
-    L.region_A0[r] = SymMat3{Real(a[0]), Real(a[1]), Real(a[2]), Real(a[3]), Real(a[4]), Real(a[5])};
+    out.c0 = c0;
+    out.A0 = SymMat3{Real(a[0]), Real(a[1]), Real(a[2]), Real(a[3]), Real(a[4]), Real(a[5])};
     const double tr = a[0] + a[1] + a[2];
-    L.region_inertia_inv[r] = regularised_inverse(tr - a[0], tr - a[1], tr - a[2], -a[3], -a[4], -a[5]);
+    out.inertia_inv = lsm_detail::regularised_inverse(tr - a[0], tr - a[1], tr - a[2], -a[3], -a[4], -a[5]);
+    return out;
+}
+
+namespace lsm_detail {
+// Region r's rest sums (region_rest_sums) into the host layout.
+inline void set_region_rest_sums(LsmHostLayout& L, std::size_t r, const std::uint32_t* members_begin,
+                                 const std::uint32_t* members_end) {
+    const RegionRestSums sums = region_rest_sums(members_begin, members_end, L.ibp_split_mass.data(), L.ibp_rest.data());
+    L.region_mass[r] = sums.mass;
+    L.region_c0[r] = sums.c0;
+    L.region_A0[r] = sums.A0;
+    L.region_inertia_inv[r] = sums.inertia_inv;
 }
 // A particle index of a solid's lists must name a particle of the setup.
 inline void check_particle_index(std::uint32_t i, std::size_t particles, const std::string& what,

@@ -19,9 +19,9 @@
 //   a region only shrinks, in place). The melted particle's slot is marked kMeltedSlot in the slot
 //   map, which every per-slot kernel skips.
 // The step's melt flags are a reduction read back (one synchronisation a step, in scenes with a
-// melting object); the rebuild is host work and a copy of the region arrays, on the steps where
-// something melted only. On the device it would take w + 1 rounds of one-ring filling
-// (docs/melting.md).
+// melting object); on a step where something melted, the exposure, the phase change and the
+// regions' rebuild run in kernels (melting_regions.hpp), and a second reduction reads back how
+// many were exposed.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "algorithms/lsm_regions.hpp"
+#include "algorithms/melting_regions.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
 #include "simulation/simulation.hpp"
@@ -87,32 +88,6 @@ inline void exchange_latent_heat(const DeviceContext& device, std::size_t ibp_co
     });
 }
 
-// The store's side of a phase change: the `melted` slots' particles become fluid and leave the
-// slot map; the `exposed` slots' particles (still solid) become SBPs.
-struct PhaseChangeData {
-    std::uint32_t* store_of_slot = nullptr;
-    std::uint8_t* type = nullptr;  // store fields
-    std::int32_t* solid_slot = nullptr;
-    std::int32_t* object = nullptr;
-    Real* density = nullptr;
-    Real rest_density = 0;
-};
-inline void apply_phase_change(const DeviceContext& device, const PhaseChangeData d, View<const std::uint32_t> melted,
-                               View<const std::uint32_t> exposed) {
-    parallel_for(device, "melting_to_fluid", melted.size(), [=] MW_HD(std::size_t k) {
-        const std::uint32_t s = melted[k];
-        const std::uint32_t i = d.store_of_slot[s];
-        d.type[i] = kFluid;
-        d.solid_slot[i] = -1;
-        d.object[i] = -1;
-        d.density[i] = d.rest_density;
-        d.store_of_slot[s] = kMeltedSlot;
-    });
-    parallel_for(device, "melting_exposed", exposed.size(), [=] MW_HD(std::size_t k) {
-        d.type[d.store_of_slot[exposed[k]]] = kSurfaceBoundary;
-    });
-}
-
 // What one step's phase change did.
 struct PhaseChangeCounts {
     long melted = 0;   // SBPs that became fluid
@@ -162,33 +137,44 @@ class PhaseChange final : public Module {
         latent_ = &store.add<Real>("latent_heat", FieldLife::kPersistent);
         latent_->fill(Real(0));
         melts_.assign(std::max<std::size_t>(1, ibp_count_), 0);
-        // Sized for the most one step can melt, so that a step allocates nothing.
-        melted_.resize(ibp_count_);
-        exposed_.resize(ibp_count_);
-        alive_.assign(ibp_count_, 1);
-        ring_.assign(ibp_count_, 0);
+        // The lattices on the device: each one's grid of cells, each vertex's grid coordinates,
+        // and the per-step flags, all sized here so that a step allocates nothing.
+        std::vector<std::uint8_t> ring(ibp_count_, 0);
+        std::vector<std::int32_t> cell_slot, slot_coord(3 * ibp_count_, 0);
         // The melting objects' particles must carry the SBP type exactly where a one-ring
         // neighbour is missing: that is what decides which may melt.
         const std::vector<std::uint8_t>& type_of_scene = setup.type;
         const int full_ring = full_ring_;
         for (const auto& m : solids.melting_lattices()) {
             lattice_particles_ += long(m.lattice.size());
-            grids_.emplace_back(m.lattice);
-            const std::vector<std::uint8_t> ring = lattice_one_ring_counts(m.lattice);
-            std::copy(ring.begin(), ring.end(), ring_.begin() + long(m.base));
+            if (m.region_half_width > kMeltingLargestHalfWidth)
+                throw InputError("simulation setup: solid \"" + setup.solids[m.object].name + "\" melts with regions of half-width " +
+                                 std::to_string(m.region_half_width) + "; at most " +
+                                 std::to_string(kMeltingLargestHalfWidth));
+            grids_.push_back(melting_grid(m.lattice, m.base, m.region_half_width, full_ring, cell_slot, slot_coord));
+            const std::vector<std::uint8_t> counts = lattice_one_ring_counts(m.lattice);
+            std::copy(counts.begin(), counts.end(), ring.begin() + long(m.base));
             const SolidSetup& solid = setup.solids[m.object];
             for (std::size_t k = 0; k < m.lattice.size(); ++k) {
-                const std::uint8_t expected = ring[k] < full_ring ? kSurfaceBoundary : kInnerBoundary;
+                const std::uint8_t expected = counts[k] < full_ring ? kSurfaceBoundary : kInnerBoundary;
                 if (type_of_scene[solid.ibp[k]] != expected)
                     throw InputError("simulation setup: solid \"" + solid.name +
-                                     "\" melts; a lattice vertex with " + std::to_string(int(ring[k])) +
+                                     "\" melts; a lattice vertex with " + std::to_string(int(counts[k])) +
                                      " of its " + std::to_string(full_ring) + " one-ring neighbours must have the " +
                                      particle_type_name(expected) +
                                      " type");
             }
         }
-        // The reduction's workspace, before the first step.
+        cell_slot_.upload(cell_slot);
+        slot_coord_.upload(slot_coord);
+        reach_.assign(cell_slot.size(), 0);
+        reach_next_.assign(cell_slot.size(), 0);
+        alive_.assign(ibp_count_, 1);
+        ring_.upload(ring);
+        exposed_.assign(std::max<std::size_t>(1, ibp_count_), 0);
+        // The reductions' workspace, before the first step.
         count_melting();
+        count_exposed();
     }
 
     bool active() const { return latent_ != nullptr; }
@@ -230,40 +216,19 @@ class PhaseChange final : public Module {
         d.melts = melts_.view().data();
         exchange_latent_heat(device_, ibp_count_, d);
         PhaseChangeCounts counts;
-        if (count_melting() == 0) return counts;
-        // Something melts: which (a copy to the host), who is exposed, the regions left.
-        melts_.download(melts_host_);
-        const std::vector<std::uint8_t>& melts = melts_host_;
-        const auto& lattices = solids.melting_lattices();
-        std::vector<std::uint32_t> melted, exposed;
-        std::vector<std::vector<std::uint32_t>> gone(lattices.size());
-        for (std::size_t o = 0; o < lattices.size(); ++o)
-            for (std::size_t k = 0; k < lattices[o].lattice.size(); ++k) {
-                const std::size_t s = lattices[o].base + k;
-                if (!melts[s]) continue;
-                melted.push_back(std::uint32_t(s));
-                gone[o].push_back(std::uint32_t(k));
-                alive_[s] = 0;
-            }
-        // A vertex whose last full one-ring lost a member is exposed: it becomes an SBP.
-        for (std::size_t o = 0; o < lattices.size(); ++o) {
-            const auto& m = lattices[o];
-            const LatticeIndex& grid = grids_[o];
-            for (std::uint32_t g : gone[o]) {
-                const long ci = m.lattice[g][0] - grid.lo[0], cj = m.lattice[g][1] - grid.lo[1],
-                           ck = m.lattice[g][2] - grid.lo[2];
-                for (long dk = -1; dk <= 1; ++dk)
-                    for (long dj = -1; dj <= 1; ++dj)
-                        for (long di = -1; di <= 1; ++di) {
-                            const std::int32_t q = grid.at(ci + di, cj + dj, ck + dk);
-                            if ((di | dj | dk) == 0 || q < 0) continue;
-                            const std::size_t s = m.base + std::size_t(q);
-                            if (ring_[s]-- == full_ring_ && alive_[s]) exposed.push_back(std::uint32_t(s));
-                        }
-            }
-        }
-        melted_.upload_range(melted.data(), 0, melted.size());
-        exposed_.upload_range(exposed.data(), 0, exposed.size());
+        counts.melted = count_melting();
+        if (counts.melted == 0) return counts;
+        // Something melts: who is exposed, the store's types, the regions left.
+        MeltingLatticeData l;
+        l.cell_slot = cell_slot_.cview().data();
+        l.slot_coord = slot_coord_.cview().data();
+        l.melts = melts_.cview().data();
+        l.alive = alive_.view().data();
+        l.ring = ring_.view().data();
+        l.exposed = exposed_.view().data();
+        l.reach = reach_.view().data();
+        l.reach_next = reach_next_.view().data();
+        l.regions = solids.melting_region_arrays();
         PhaseChangeData p;
         p.store_of_slot = solids.slot_map().data();
         p.type = store.type.view().data();
@@ -271,12 +236,12 @@ class PhaseChange final : public Module {
         p.object = store.object.view().data();
         p.density = store.density.view().data();
         p.rest_density = rest_density;
-        apply_phase_change(device_, p, View<const std::uint32_t>{melted_.cview().data(), melted.size()},
-                           View<const std::uint32_t>{exposed_.cview().data(), exposed.size()});
-        solids.rebuild_melting_regions(alive_, &gone);
-        counts.melted = long(melted.size());
+        for (const MeltingGrid& g : grids_) {
+            update_melting_lattice(device_, g, l);
+            apply_phase_change(device_, g, p, l);
+        }
         melted_total_ += counts.melted;
-        counts.exposed = long(exposed.size());
+        counts.exposed = count_exposed();
         return counts;
     }
 
@@ -290,20 +255,25 @@ class PhaseChange final : public Module {
         std::vector<std::uint8_t> held(ibp_count_, 0);
         for (std::size_t i = 0; i < store.moving_count(); ++i)
             if (slot[i] >= 0 && std::size_t(slot[i]) < ibp_count_) held[std::size_t(slot[i])] = 1;
-        alive_.assign(ibp_count_, 1);
+        std::vector<std::uint8_t> alive(ibp_count_, 1), ring(ibp_count_, 0);
         for (const auto& m : solids.melting_lattices()) {
-            for (std::size_t k = 0; k < m.lattice.size(); ++k) alive_[m.base + k] = held[m.base + k];
-            const std::vector<std::uint8_t> ring = lattice_one_ring_counts(
+            for (std::size_t k = 0; k < m.lattice.size(); ++k) alive[m.base + k] = held[m.base + k];
+            const std::vector<std::uint8_t> counts = lattice_one_ring_counts(
                 m.lattice, std::vector<std::uint8_t>(held.begin() + long(m.base), held.begin() + long(m.base + m.lattice.size())));
-            std::copy(ring.begin(), ring.end(), ring_.begin() + long(m.base));
+            std::copy(counts.begin(), counts.end(), ring.begin() + long(m.base));
         }
-        melted_total_ = long(std::count(alive_.begin(), alive_.end(), std::uint8_t(0)));
-        solids.rebuild_melting_regions(alive_);
+        alive_.upload(alive);
+        ring_.upload(ring);
+        melted_total_ = long(std::count(alive.begin(), alive.end(), std::uint8_t(0)));
+        solids.rebuild_melting_regions(alive);
         solids.slot_map_fill(kMeltedSlot);
         solids.update_slot_map(store);
     }
 
-    std::size_t bytes() const override { return points_.bytes() + melts_.bytes() + melted_.bytes() + exposed_.bytes(); }
+    std::size_t bytes() const override {
+        return points_.bytes() + melts_.bytes() + exposed_.bytes() + alive_.bytes() + ring_.bytes() + cell_slot_.bytes() +
+               slot_coord_.bytes() + reach_.bytes() + reach_next_.bytes();
+    }
 
     // The number of slots flagged to melt this step (a reduction read back). Public only because
     // nvcc allows no device lambda in a private member function.
@@ -311,6 +281,12 @@ class PhaseChange final : public Module {
         const std::uint8_t* melts = melts_.cview().data();
         return long(transform_reduce(device_, "melting_count", ibp_count_, std::uint32_t(0), SumOp{},
                                      [=] MW_HD(std::size_t s) { return std::uint32_t(melts[s]); }));
+    }
+    // The number of slots exposed this step (a reduction read back).
+    long count_exposed() {
+        const std::uint8_t* exposed = exposed_.cview().data();
+        return long(transform_reduce(device_, "melting_exposed_count", ibp_count_, std::uint32_t(0), SumOp{},
+                                     [=] MW_HD(std::size_t s) { return std::uint32_t(exposed[s]); }));
     }
 
    private:
@@ -324,14 +300,16 @@ class PhaseChange final : public Module {
     DeviceArray<MeltingPoint> points_;         // per object
     DeviceArray<Real>* latent_ = nullptr;      // store field: heat absorbed at T_m, K
     DeviceArray<std::uint8_t> melts_;          // per IBP slot, this step's
-    DeviceArray<std::uint32_t> melted_, exposed_;  // this step's lists (capacity: every IBP slot)
-    std::vector<std::uint8_t> alive_;          // host, per IBP slot: still in its object
-    std::vector<std::uint8_t> melts_host_;     // host copy of melts_, on steps where something melts
+    DeviceArray<std::uint8_t> exposed_;        // per IBP slot: exposed this step
+    DeviceArray<std::uint8_t> alive_;          // per IBP slot: still in its object
+    DeviceArray<std::uint8_t> ring_;           // per IBP slot: one-ring neighbours still in it
+    DeviceArray<std::int32_t> cell_slot_;      // per cell of the melting lattices' grids: its vertex's slot, -1 none
+    DeviceArray<std::int32_t> slot_coord_;     // per IBP slot: its grid coordinates (3)
+    DeviceArray<std::uint8_t> reach_, reach_next_;  // per cell: steps to a vertex gone this step
     long melted_total_ = 0;
     long lattice_particles_ = 0;               // of the melting objects, at the start
-    std::vector<std::uint8_t> ring_;           // host, per IBP slot: one-ring neighbours still in it
     int full_ring_ = 26;                       // a vertex's one-ring neighbours: 26, or 8 in 2D
-    std::vector<LatticeIndex> grids_;  // host, per melting object: its lattice's grid
+    std::vector<MeltingGrid> grids_;           // per melting object: its lattice's grid
 };
 
 MW_BACKEND_END

@@ -207,19 +207,13 @@ class SolidBodies final : public Module {
     };
     const std::vector<MeltingLattice>& melting_lattices() const { return melting_; }
 
-    // Rebuilds the melting objects' regions over the IBP slots still `alive` (per IBP slot) and
-    // uploads them (lsm_regions.hpp, rebuild_elastic_object_regions): near the vertices `gone`
-    // since the last rebuild (per melting object, local indices), or everywhere without it. Host
-    // work and a copy of the region arrays: only on a step where something melted, and on
-    // loading a checkpoint.
-    void rebuild_melting_regions(const std::vector<std::uint8_t>& alive,
-                                 const std::vector<std::vector<std::uint32_t>>* gone = nullptr) {
+    // Rebuilds the melting objects' regions over the IBP slots still `alive` (per IBP slot)
+    // everywhere on the host, and uploads them (lsm_regions.hpp, rebuild_elastic_object_regions):
+    // on loading a checkpoint. A step's melting rebuilds them on the device (melting_regions.hpp).
+    void rebuild_melting_regions(const std::vector<std::uint8_t>& alive) {
         LsmHostLayout& L = host_layout_;
-        for (std::size_t k = 0; k < melting_.size(); ++k) {
-            const MeltingLattice& m = melting_[k];
-            if (gone && (*gone)[k].empty()) continue;
-            rebuild_elastic_object_regions(L, m.lattice, m.region_half_width, m.base, alive, gone ? &(*gone)[k] : nullptr);
-        }
+        for (const MeltingLattice& m : melting_)
+            rebuild_elastic_object_regions(L, m.lattice, m.region_half_width, m.base, alive);
         member_index_.upload(L.member_index);
         region_end_.upload(L.region_end);
         regions_end_.upload(L.ibp_regions_end);
@@ -228,6 +222,23 @@ class SolidBodies final : public Module {
         region_c0_.upload(L.region_c0);
         region_A0_.upload(L.region_A0);
         region_inertia_inv_.upload(L.region_inertia_inv);
+    }
+    // The region arrays that melting rebuilds on the device (melting_regions.hpp).
+    MeltingRegionArrays melting_region_arrays() {
+        MeltingRegionArrays r;
+        r.rest = rest_.cview().data();
+        r.mass = mass_.cview().data();
+        r.region_offsets = region_offsets_.cview().data();
+        r.regions_begin = regions_begin_.cview().data();
+        r.region_end = region_end_.view().data();
+        r.regions_end = regions_end_.view().data();
+        r.member_index = member_index_.view().data();
+        r.split_mass = split_mass_.view().data();
+        r.region_mass = region_mass_.view().data();
+        r.region_c0 = region_c0_.view().data();
+        r.region_A0 = region_A0_.view().data();
+        r.region_inertia_inv = region_inertia_inv_.view().data();
+        return r;
     }
     // The slot map (melting.hpp marks melted slots in it) and each IBP and SBP slot's object.
     View<std::uint32_t> slot_map() { return store_of_slot_.view(); }

@@ -8,6 +8,7 @@
 
 #include "../skip.hpp"
 #include "algorithms/lsm_regions.hpp"
+#include "algorithms/melting_regions.hpp"
 #include "simulation/factory.hpp"
 #include "test_setups.hpp"
 
@@ -137,6 +138,116 @@ TEST_CASE("regions rebuilt over the vertices left are those of an object built f
     MESSAGE(compared << " regions compared");
     CHECK(compared == 2 * (5 * 5 * 5 - 3));
     CHECK(mismatched == 0);
+}
+
+TEST_CASE("a step's melting updates the lattice on the device as the host would, bit for bit") {
+    // A 9³ cube (w 2, and w 1) losing, step by step, its outer shell, a few scattered vertices
+    // inside, and then a whole face layer: after each step the device's exposed vertices and
+    // regions (melting_regions.hpp) against the host's (one-ring counts, and
+    // rebuild_elastic_object_regions near what went).
+    const int n = 9;
+    for (const int w : {2, 1}) {
+        CAPTURE(w);
+        SimulationSetup whole = lattice_cube(n);
+        whole.solids[0].region_half_width = w;
+        const auto& lattice = whole.solids[0].lattice;
+        LsmHostLayout host = build_lsm_layout(whole);
+        const std::size_t count = lattice.size();
+        std::vector<std::uint8_t> alive(count, 1);
+        std::vector<std::uint8_t> ring = lattice_one_ring_counts(lattice);
+
+        const DeviceContext device;
+        std::vector<std::int32_t> cell_slot, slot_coord(3 * count, 0);
+        const MeltingGrid g = melting_grid(lattice, 0, w, 26, cell_slot, slot_coord);
+        DeviceArray<std::int32_t> cells, coords;
+        cells.upload(cell_slot);
+        coords.upload(slot_coord);
+        DeviceArray<std::uint8_t> melts(count), alive_d, ring_d, exposed(count), reach(cell_slot.size()), reach_next(cell_slot.size());
+        alive_d.upload(alive);
+        ring_d.upload(ring);
+        DeviceArray<Vec3> rest, c0;
+        DeviceArray<Real> mass, split_mass, region_mass;
+        DeviceArray<std::uint32_t> offsets, regions_begin, region_end, regions_end, members;
+        DeviceArray<SymMat3> A0, inertia_inv;
+        rest.upload(host.ibp_rest);
+        mass.upload(host.ibp_mass);
+        offsets.upload(host.region_offsets);
+        regions_begin.upload(host.ibp_regions_begin);
+        region_end.upload(host.region_end);
+        regions_end.upload(host.ibp_regions_end);
+        members.upload(host.member_index);
+        split_mass.upload(host.ibp_split_mass);
+        region_mass.upload(host.region_mass);
+        c0.upload(host.region_c0);
+        A0.upload(host.region_A0);
+        inertia_inv.upload(host.region_inertia_inv);
+        MeltingLatticeData d;
+        d.cell_slot = cells.cview().data();
+        d.slot_coord = coords.cview().data();
+        d.melts = melts.cview().data();
+        d.alive = alive_d.view().data();
+        d.ring = ring_d.view().data();
+        d.exposed = exposed.view().data();
+        d.reach = reach.view().data();
+        d.reach_next = reach_next.view().data();
+        d.regions = MeltingRegionArrays{rest.cview().data(), mass.cview().data(), offsets.cview().data(),
+                                        regions_begin.cview().data(), region_end.view().data(), regions_end.view().data(),
+                                        members.view().data(), split_mass.view().data(), region_mass.view().data(),
+                                        c0.view().data(), A0.view().data(), inertia_inv.view().data()};
+
+        // The three steps' melts, as local indices.
+        std::vector<std::vector<std::uint32_t>> steps(3);
+        for (int z = 0; z < n; ++z)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    const std::uint32_t k = std::uint32_t((z * n + y) * n + x);
+                    const bool shell = x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1;
+                    if (shell) steps[0].push_back(k);
+                    else if ((x == 4 && y == 4 && z == 4) || (x == 3 && y == 5 && z == 4) || (x == 5 && y == 2 && z == 3))
+                        steps[1].push_back(k);
+                    else if (z == 1) steps[2].push_back(k);
+                }
+        long exposed_total = 0, regions_compared = 0, mismatched = 0;
+        for (const std::vector<std::uint32_t>& gone : steps) {
+            // The host: who is exposed, then the regions near what went.
+            std::vector<std::uint8_t> flags(count, 0), exposed_host(count, 0);
+            for (const std::uint32_t k : gone) flags[k] = 1, alive[k] = 0;
+            const std::vector<std::uint8_t> left = lattice_one_ring_counts(lattice, alive);
+            for (std::size_t k = 0; k < count; ++k) {
+                if (!alive[k]) continue;
+                exposed_host[k] = ring[k] == 26 && left[k] < 26;
+                ring[k] = left[k];
+            }
+            rebuild_elastic_object_regions(host, lattice, w, 0, alive, &gone);
+            // The device.
+            melts.upload(flags);
+            update_melting_lattice(device, g, d);
+            CHECK(exposed.to_host() == exposed_host);
+            CHECK(alive_d.to_host() == alive);
+            exposed_total += std::count(exposed_host.begin(), exposed_host.end(), std::uint8_t(1));
+            const std::vector<std::uint32_t> end_d = region_end.to_host(), ends_d = regions_end.to_host(), members_d = members.to_host();
+            const std::vector<Real> split_d = split_mass.to_host(), mass_d = region_mass.to_host();
+            const std::vector<Vec3> c0_d = c0.to_host();
+            const std::vector<SymMat3> A0_d = A0.to_host(), inverse_d = inertia_inv.to_host();
+            for (std::size_t s = 0; s < count; ++s) {
+                ++regions_compared;
+                bool same = end_d[s] == host.region_end[s] && ends_d[s] == host.ibp_regions_end[s] &&
+                            std::memcmp(&mass_d[s], &host.region_mass[s], sizeof(Real)) == 0;
+                if (alive[s]) {
+                    for (std::uint32_t m = host.region_offsets[s]; m < host.region_end[s]; ++m)
+                        same = same && members_d[m] == host.member_index[m];
+                    same = same && std::memcmp(&split_d[s], &host.ibp_split_mass[s], sizeof(Real)) == 0 &&
+                           std::memcmp(&c0_d[s], &host.region_c0[s], sizeof(Vec3)) == 0 &&
+                           std::memcmp(&A0_d[s], &host.region_A0[s], sizeof(SymMat3)) == 0 &&
+                           std::memcmp(&inverse_d[s], &host.region_inertia_inv[s], sizeof(SymMat3)) == 0;
+                }
+                mismatched += !same;
+            }
+        }
+        MESSAGE("w " << w << ": " << exposed_total << " vertices exposed, " << regions_compared << " regions compared");
+        CHECK(exposed_total > 7 * 7 * 7 - 5 * 5 * 5);  // the shell's step exposes the 7³ cube's surface, and more follow
+        CHECK(mismatched == 0);
+    }
 }
 
 TEST_CASE("an object above its melting point melts from the outside in, one lattice layer a step, to the last particle") {
