@@ -148,7 +148,9 @@ TEST_CASE("A clamped rod's sag at rest follows shape matching's law: g dt^2 / al
     // gravity's g dt² per step: g dt² / α from its goal. Small, the sag is linear in those
     // offsets: proportional to dt² / α (docs/rods.md).
     std::map<std::pair<double, double>, double> sags;
-    for (const auto& [dt, alpha] : std::vector<std::pair<double, double>>{{0.001, 0.5}, {0.0005, 0.5}, {0.00025, 0.5}, {0.0005, 1.0}}) {
+    for (const auto& step_and_alpha : std::vector<std::pair<double, double>>{{0.001, 0.5}, {0.0005, 0.5}, {0.00025, 0.5}, {0.0005, 1.0}}) {
+        // Named copies: INFO's lambda cannot capture a structured binding under clang 14.
+        const double dt = step_and_alpha.first, alpha = step_and_alpha.second;
         const std::unique_ptr<Simulation> sim = create_openmp_simulation(setup_of(cantilever(dt, alpha)), 1);
         while (sim->time() < 2.0 - 1e-9) sim->step();
         HostParticles p;
