@@ -139,7 +139,6 @@ class PhaseChange final : public Module {
         melts_.assign(std::max<std::size_t>(1, ibp_count_), 0);
         // The lattices on the device: each one's grid of cells, each vertex's grid coordinates,
         // and the per-step flags, all sized here so that a step allocates nothing.
-        std::vector<std::uint8_t> ring(ibp_count_, 0);
         std::vector<std::int32_t> cell_slot, slot_coord(3 * ibp_count_, 0);
         // The melting objects' particles must carry the SBP type exactly where a one-ring
         // neighbour is missing: that is what decides which may melt.
@@ -153,7 +152,6 @@ class PhaseChange final : public Module {
                                  std::to_string(kMeltingLargestHalfWidth));
             grids_.push_back(melting_grid(m.lattice, m.base, m.region_half_width, full_ring, cell_slot, slot_coord));
             const std::vector<std::uint8_t> counts = lattice_one_ring_counts(m.lattice);
-            std::copy(counts.begin(), counts.end(), ring.begin() + long(m.base));
             const SolidSetup& solid = setup.solids[m.object];
             for (std::size_t k = 0; k < m.lattice.size(); ++k) {
                 const std::uint8_t expected = counts[k] < full_ring ? kSurfaceBoundary : kInnerBoundary;
@@ -169,8 +167,6 @@ class PhaseChange final : public Module {
         slot_coord_.upload(slot_coord);
         reach_.assign(cell_slot.size(), 0);
         reach_next_.assign(cell_slot.size(), 0);
-        alive_.assign(ibp_count_, 1);
-        ring_.upload(ring);
         exposed_.assign(std::max<std::size_t>(1, ibp_count_), 0);
         // The reductions' workspace, before the first step.
         count_melting();
@@ -223,23 +219,18 @@ class PhaseChange final : public Module {
         l.cell_slot = cell_slot_.cview().data();
         l.slot_coord = slot_coord_.cview().data();
         l.melts = melts_.cview().data();
-        l.alive = alive_.view().data();
-        l.ring = ring_.view().data();
         l.exposed = exposed_.view().data();
         l.reach = reach_.view().data();
         l.reach_next = reach_next_.view().data();
         l.regions = solids.melting_region_arrays();
-        PhaseChangeData p;
+        PhaseChangeData& p = l.particles;
         p.store_of_slot = solids.slot_map().data();
         p.type = store.type.view().data();
         p.solid_slot = solids.solid_slot_field().view().data();
         p.object = store.object.view().data();
         p.density = store.density.view().data();
         p.rest_density = rest_density;
-        for (const MeltingGrid& g : grids_) {
-            update_melting_lattice(device_, g, l);
-            apply_phase_change(device_, g, p, l);
-        }
+        for (const MeltingGrid& g : grids_) update_melting_lattice(device_, g, l);
         melted_total_ += counts.melted;
         counts.exposed = count_exposed();
         return counts;
@@ -255,15 +246,9 @@ class PhaseChange final : public Module {
         std::vector<std::uint8_t> held(ibp_count_, 0);
         for (std::size_t i = 0; i < store.moving_count(); ++i)
             if (slot[i] >= 0 && std::size_t(slot[i]) < ibp_count_) held[std::size_t(slot[i])] = 1;
-        std::vector<std::uint8_t> alive(ibp_count_, 1), ring(ibp_count_, 0);
-        for (const auto& m : solids.melting_lattices()) {
+        std::vector<std::uint8_t> alive(ibp_count_, 1);
+        for (const auto& m : solids.melting_lattices())
             for (std::size_t k = 0; k < m.lattice.size(); ++k) alive[m.base + k] = held[m.base + k];
-            const std::vector<std::uint8_t> counts = lattice_one_ring_counts(
-                m.lattice, std::vector<std::uint8_t>(held.begin() + long(m.base), held.begin() + long(m.base + m.lattice.size())));
-            std::copy(counts.begin(), counts.end(), ring.begin() + long(m.base));
-        }
-        alive_.upload(alive);
-        ring_.upload(ring);
         melted_total_ = long(std::count(alive.begin(), alive.end(), std::uint8_t(0)));
         solids.rebuild_melting_regions(alive);
         solids.slot_map_fill(kMeltedSlot);
@@ -271,7 +256,7 @@ class PhaseChange final : public Module {
     }
 
     std::size_t bytes() const override {
-        return points_.bytes() + melts_.bytes() + exposed_.bytes() + alive_.bytes() + ring_.bytes() + cell_slot_.bytes() +
+        return points_.bytes() + melts_.bytes() + exposed_.bytes() + cell_slot_.bytes() +
                slot_coord_.bytes() + reach_.bytes() + reach_next_.bytes();
     }
 
@@ -301,8 +286,6 @@ class PhaseChange final : public Module {
     DeviceArray<Real>* latent_ = nullptr;      // store field: heat absorbed at T_m, K
     DeviceArray<std::uint8_t> melts_;          // per IBP slot, this step's
     DeviceArray<std::uint8_t> exposed_;        // per IBP slot: exposed this step
-    DeviceArray<std::uint8_t> alive_;          // per IBP slot: still in its object
-    DeviceArray<std::uint8_t> ring_;           // per IBP slot: one-ring neighbours still in it
     DeviceArray<std::int32_t> cell_slot_;      // per cell of the melting lattices' grids: its vertex's slot, -1 none
     DeviceArray<std::int32_t> slot_coord_;     // per IBP slot: its grid coordinates (3)
     DeviceArray<std::uint8_t> reach_, reach_next_;  // per cell: steps to a vertex gone this step

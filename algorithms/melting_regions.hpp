@@ -1,6 +1,9 @@
 // A melting object's lattice on the device, and what a step's phase change does to it there
-// (melting.hpp): which vertices are left, which became exposed, and the LSM regions rebuilt over
-// the vertices left. The host learns only how many melted and how many were exposed.
+// (melting.hpp): the vertices that melt become fluid, those they leave exposed become SBPs, and the
+// LSM regions are rebuilt over the vertices left. What is left is the slot map's (a melted slot
+// holds kMeltedSlot) and what is exposed the store's types (an IBP is a vertex with its full
+// one-ring), so nothing else is kept. The host learns only how many melted and how many were
+// exposed.
 //
 // The rebuild gives, bit for bit, what rebuild_elastic_object_regions (lsm_regions.hpp) gives on
 // the host: a region is redone where a vertex gone this step lies within w lattice steps of its
@@ -42,17 +45,27 @@ struct MeltingGrid {
     }
 };
 
+// The store's side of a phase change: the slot map and the particles' fields it changes.
+struct PhaseChangeData {
+    std::uint32_t* store_of_slot = nullptr;
+    std::uint8_t* type = nullptr;  // store fields
+    std::int32_t* solid_slot = nullptr;
+    std::int32_t* object = nullptr;
+    Real* density = nullptr;
+    Real rest_density = 0;
+};
 // The per-step state of the melting lattices and the region arrays the rebuild writes.
 struct MeltingLatticeData {
     const std::int32_t* cell_slot = nullptr;  // per cell: the slot of its vertex, -1 none
     const std::int32_t* slot_coord = nullptr; // per IBP slot of a melting object: its grid i, j, k (3 each)
     const std::uint8_t* melts = nullptr;      // per IBP slot: it melts this step
-    std::uint8_t* alive = nullptr;            // per IBP slot: still in its object
-    std::uint8_t* ring = nullptr;             // per IBP slot: one-ring neighbours still in the object
     std::uint8_t* exposed = nullptr;          // per IBP slot: became an SBP this step
     std::uint8_t* reach = nullptr;            // per cell: lattice steps to the nearest vertex gone this step (at most 2w + 1)
     std::uint8_t* reach_next = nullptr;       // per cell: the dilation's other buffer
     MeltingRegionArrays regions;
+    PhaseChangeData particles;
+    // Whether slot s's vertex is still in its object.
+    MW_HD bool left(std::int32_t s) const { return particles.store_of_slot[s] != kMeltedSlot; }
 };
 
 // This step's reach, by 2w dilations of the vertices that melt (Chebyshev distance, as the host
@@ -85,17 +98,27 @@ inline void melting_reach(const DeviceContext& device, const MeltingGrid g, cons
     }
 }
 
-// The vertices that melt leave; a vertex left whose full one-ring lost a member is exposed.
-inline void melting_exposure(const DeviceContext& device, const MeltingGrid g, const MeltingLatticeData d) {
-    parallel_for(device, "melting_leave", g.count, [=] MW_HD(std::size_t k) {
+// The vertices that melt become fluid and leave the slot map; then an IBP (a vertex with its full
+// one-ring) that lost a one-ring neighbour is exposed and becomes an SBP.
+inline void melting_phase_change(const DeviceContext& device, const MeltingGrid g, const MeltingLatticeData d) {
+    parallel_for(device, "melting_to_fluid", g.count, [=] MW_HD(std::size_t k) {
         const std::uint32_t s = g.base + std::uint32_t(k);
-        if (d.melts[s]) d.alive[s] = 0;
+        if (!d.melts[s]) return;
+        const PhaseChangeData p = d.particles;
+        const std::uint32_t i = p.store_of_slot[s];
+        p.type[i] = kFluid;
+        p.solid_slot[i] = -1;
+        p.object[i] = -1;
+        p.density[i] = p.rest_density;
+        p.store_of_slot[s] = kMeltedSlot;
     });
     parallel_for(device, "melting_exposed", g.count, [=] MW_HD(std::size_t k) {
         const std::uint32_t s = g.base + std::uint32_t(k);
         d.exposed[s] = 0;
         const std::int32_t* at = d.slot_coord + 3 * std::size_t(s);
-        if (!d.alive[s] || d.reach[g.cell(at[0], at[1], at[2])] > 1) return;
+        if (!d.left(std::int32_t(s)) || d.reach[g.cell(at[0], at[1], at[2])] > 1) return;
+        const std::uint32_t i = d.particles.store_of_slot[s];
+        if (d.particles.type[i] != kInnerBoundary) return;
         int left = 0;
         for (std::int32_t dk = -1; dk <= 1; ++dk)
             for (std::int32_t dj = -1; dj <= 1; ++dj)
@@ -104,10 +127,11 @@ inline void melting_exposure(const DeviceContext& device, const MeltingGrid g, c
                     const std::int64_t n = g.cell(at[0] + di, at[1] + dj, at[2] + dk);
                     if (n < 0) continue;
                     const std::int32_t q = d.cell_slot[n];
-                    left += q >= 0 && d.alive[q];
+                    left += q >= 0 && d.left(q);
                 }
-        d.exposed[s] = d.ring[s] == g.full_ring && left < g.full_ring ? 1 : 0;
-        d.ring[s] = std::uint8_t(left);
+        if (left == g.full_ring) return;
+        d.particles.type[i] = kSurfaceBoundary;
+        d.exposed[s] = 1;
     });
 }
 
@@ -124,7 +148,7 @@ inline void melting_region_members(const DeviceContext& device, const MeltingGri
             return;
         }
         const std::int32_t* at = d.slot_coord + 3 * std::size_t(s);
-        if (!d.alive[s] || d.reach[g.cell(at[0], at[1], at[2])] > g.half_width) return;
+        if (!d.left(std::int32_t(s)) || d.reach[g.cell(at[0], at[1], at[2])] > g.half_width) return;
         // Flood fill over the box of half-width w round the centre, w one-ring steps.
         const std::int32_t w = g.half_width, side = 2 * w + 1;
         std::uint64_t reached[kMeltingBoxWords], frontier[kMeltingBoxWords], next[kMeltingBoxWords];
@@ -143,7 +167,7 @@ inline void melting_region_members(const DeviceContext& device, const MeltingGri
                         const std::int64_t cell = g.cell(at[0] + bi - w, at[1] + bj - w, at[2] + bk - w);
                         if (cell < 0) continue;
                         const std::int32_t q = d.cell_slot[cell];
-                        if (q < 0 || !d.alive[q]) continue;
+                        if (q < 0 || !d.left(q)) continue;
                         bool linked = false;
                         for (std::int32_t dk = -1; dk <= 1 && !linked; ++dk)
                             for (std::int32_t dj = -1; dj <= 1 && !linked; ++dj)
@@ -186,7 +210,7 @@ inline void melting_region_rest_sums(const DeviceContext& device, const MeltingG
     parallel_for(device, "melting_region_rest_sums", g.count, [=] MW_HD(std::size_t k) {
         const std::uint32_t s = g.base + std::uint32_t(k);
         const std::int32_t* at = d.slot_coord + 3 * std::size_t(s);
-        if (!d.alive[s] || d.reach[g.cell(at[0], at[1], at[2])] > 2 * g.half_width) return;
+        if (!d.left(std::int32_t(s)) || d.reach[g.cell(at[0], at[1], at[2])] > 2 * g.half_width) return;
         const MeltingRegionArrays r = d.regions;
         const RegionRestSums sums = region_rest_sums(r.member_index + r.region_offsets[s], r.member_index + r.region_end[s],
                                                      r.split_mass, r.rest);
@@ -197,11 +221,11 @@ inline void melting_region_rest_sums(const DeviceContext& device, const MeltingG
     });
 }
 
-// One step's update of a lattice whose `melts` flags are set: reach, exposure, the regions'
-// members and rest sums.
+// One step's update of a lattice whose `melts` flags are set: reach, the phase change and the
+// exposure, the regions' members and rest sums.
 inline void update_melting_lattice(const DeviceContext& device, const MeltingGrid g, const MeltingLatticeData d) {
     melting_reach(device, g, d);
-    melting_exposure(device, g, d);
+    melting_phase_change(device, g, d);
     melting_region_members(device, g, d);
     melting_region_rest_sums(device, g, d);
 }
@@ -222,33 +246,6 @@ inline MeltingGrid melting_grid(const std::vector<std::array<int, 3>>& lattice, 
     for (std::size_t k = 0; k < lattice.size(); ++k)
         for (int a = 0; a < 3; ++a) slot_coord[3 * (base + k) + std::size_t(a)] = lattice[k][a] - grid.lo[a];
     return g;
-}
-
-// The store's side: the melting slots' particles become fluid and leave the slot map, the exposed
-// ones become SBPs.
-struct PhaseChangeData {
-    std::uint32_t* store_of_slot = nullptr;
-    std::uint8_t* type = nullptr;  // store fields
-    std::int32_t* solid_slot = nullptr;
-    std::int32_t* object = nullptr;
-    Real* density = nullptr;
-    Real rest_density = 0;
-};
-inline void apply_phase_change(const DeviceContext& device, const MeltingGrid g, const PhaseChangeData p,
-                               const MeltingLatticeData d) {
-    parallel_for(device, "melting_phase_change", g.count, [=] MW_HD(std::size_t k) {
-        const std::uint32_t s = g.base + std::uint32_t(k);
-        if (d.melts[s]) {
-            const std::uint32_t i = p.store_of_slot[s];
-            p.type[i] = kFluid;
-            p.solid_slot[i] = -1;
-            p.object[i] = -1;
-            p.density[i] = p.rest_density;
-            p.store_of_slot[s] = kMeltedSlot;
-        } else if (d.exposed[s]) {
-            p.type[p.store_of_slot[s]] = kSurfaceBoundary;
-        }
-    });
 }
 
 MW_BACKEND_END

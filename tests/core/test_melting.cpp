@@ -162,9 +162,18 @@ TEST_CASE("a step's melting updates the lattice on the device as the host would,
         DeviceArray<std::int32_t> cells, coords;
         cells.upload(cell_slot);
         coords.upload(slot_coord);
-        DeviceArray<std::uint8_t> melts(count), alive_d, ring_d, exposed(count), reach(cell_slot.size()), reach_next(cell_slot.size());
-        alive_d.upload(alive);
-        ring_d.upload(ring);
+        DeviceArray<std::uint8_t> melts(count), exposed(count), reach(cell_slot.size()), reach_next(cell_slot.size());
+        // The store: one particle per slot, in slot order, typed by its one-ring.
+        std::vector<std::uint32_t> identity(count);
+        std::vector<std::uint8_t> types(count);
+        for (std::size_t k = 0; k < count; ++k)
+            identity[k] = std::uint32_t(k), types[k] = ring[k] == 26 ? kInnerBoundary : kSurfaceBoundary;
+        DeviceArray<std::uint32_t> slot_map;
+        DeviceArray<std::uint8_t> type;
+        DeviceArray<std::int32_t> solid_slot(count), object(count);
+        DeviceArray<Real> density(count);
+        slot_map.upload(identity);
+        type.upload(types);
         DeviceArray<Vec3> rest, c0;
         DeviceArray<Real> mass, split_mass, region_mass;
         DeviceArray<std::uint32_t> offsets, regions_begin, region_end, regions_end, members;
@@ -185,8 +194,6 @@ TEST_CASE("a step's melting updates the lattice on the device as the host would,
         d.cell_slot = cells.cview().data();
         d.slot_coord = coords.cview().data();
         d.melts = melts.cview().data();
-        d.alive = alive_d.view().data();
-        d.ring = ring_d.view().data();
         d.exposed = exposed.view().data();
         d.reach = reach.view().data();
         d.reach_next = reach_next.view().data();
@@ -194,6 +201,8 @@ TEST_CASE("a step's melting updates the lattice on the device as the host would,
                                         regions_begin.cview().data(), region_end.view().data(), regions_end.view().data(),
                                         members.view().data(), split_mass.view().data(), region_mass.view().data(),
                                         c0.view().data(), A0.view().data(), inertia_inv.view().data()};
+        d.particles = PhaseChangeData{slot_map.view().data(), type.view().data(), solid_slot.view().data(),
+                                      object.view().data(), density.view().data(), Real(1000)};
 
         // The three steps' melts, as local indices.
         std::vector<std::vector<std::uint32_t>> steps(3);
@@ -223,7 +232,15 @@ TEST_CASE("a step's melting updates the lattice on the device as the host would,
             melts.upload(flags);
             update_melting_lattice(device, g, d);
             CHECK(exposed.to_host() == exposed_host);
-            CHECK(alive_d.to_host() == alive);
+            const std::vector<std::uint32_t> slots_d = slot_map.to_host();
+            const std::vector<std::uint8_t> types_d = type.to_host();
+            long type_mismatches = 0;
+            for (std::size_t k = 0; k < count; ++k) {
+                CHECK((slots_d[k] != kMeltedSlot) == bool(alive[k]));
+                const std::uint8_t expected = !alive[k] ? kFluid : ring[k] == 26 ? kInnerBoundary : kSurfaceBoundary;
+                type_mismatches += types_d[k] != expected;
+            }
+            CHECK(type_mismatches == 0);
             exposed_total += std::count(exposed_host.begin(), exposed_host.end(), std::uint8_t(1));
             const std::vector<std::uint32_t> end_d = region_end.to_host(), ends_d = regions_end.to_host(), members_d = members.to_host();
             const std::vector<Real> split_d = split_mass.to_host(), mass_d = region_mass.to_host();
