@@ -93,6 +93,8 @@ struct CouplingData {
     // The impulses the velocity–position correction gave the SBPs in the last step (per SBP;
     // null without it, solid_contact.hpp): they join this step's reaction as J / Δt.
     const Vec3* sbp_contact_impulse = nullptr;
+    // The same per IBP slot, for a melting lattice's exposed vertices; null without a melting object.
+    const Vec3* lattice_contact_impulse = nullptr;
     Real inverse_dt = 0;
     // Interface tension's η per SBP (interface_tension.hpp); null: none. It pulls toward the
     // SBPs' face points.
@@ -196,6 +198,7 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
                         (pressure_scale * vb_volume * eta) * tension_sum;
         if (d.sbp_contact_impulse && s >= d.ibp_count)
             reaction += d.inverse_dt * d.sbp_contact_impulse[s - d.ibp_count];
+        if (d.lattice_contact_impulse && s < d.ibp_count) reaction += d.inverse_dt * d.lattice_contact_impulse[s];
         d.reaction[s] = reaction;
     });
 }

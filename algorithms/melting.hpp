@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "algorithms/lsm_regions.hpp"
+#include "algorithms/melting_faces.hpp"
 #include "algorithms/melting_regions.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
@@ -133,6 +134,7 @@ class PhaseChange final : public Module {
         if (!temperature_) throw InputError("simulation setup: melting needs heat conduction");
         ibp_count_ = solids.ibp_count();
         full_ring_ = full_one_ring(setup.params.dimensions);
+        sheet_below_ = static_cast<Real>(lattice_sheet_threshold(full_ring_) * double(setup.params.fluid.spacing));
         points_.upload(points);
         latent_ = &store.add<Real>("latent_heat", FieldLife::kPersistent);
         latent_->fill(Real(0));
@@ -176,7 +178,28 @@ class PhaseChange final : public Module {
     bool active() const { return latent_ != nullptr; }
 
     void bind(StepPlan& plan) override {
-        if (active()) plan.bind("melting", [this](StepContext&) { melt(); });
+        if (!active()) return;
+        if (solids_.lattice_faces().normal) plan.bind("neighbors", [this](StepContext&) { find_faces(); });
+        plan.bind("melting", [this](StepContext&) { melt(); });
+    }
+    // After the sort: the exposed vertices' normals and contact masses for the correction
+    // (melting_faces.hpp).
+    void find_faces() {
+        const MeltingRegionArrays r = solids_.melting_region_arrays();
+        LatticeFaceInputs in;
+        in.cell_slot = cell_slot_.cview().data();
+        in.slot_coord = slot_coord_.cview().data();
+        in.store_of_slot = solids_.slot_map().data();
+        in.type = store_.type.cview().data();
+        in.position = store_.position.cview().data();
+        in.pinned = solids_.pinned_slots().data();
+        in.regions_begin = r.regions_begin;
+        in.regions_end = r.regions_end;
+        in.member_index = r.member_index;
+        in.region_mass = r.region_mass;
+        in.sheet_below = sheet_below_;
+        const LatticeFaceArrays out = solids_.lattice_faces();
+        for (const MeltingGrid& g : grids_) melting_lattice_faces(device_, g, in, out);
     }
     // Latent heat at the melting point, then the melting objects' SBPs that melt become fluid (the
     // next step's sort moves them to the fluid's range), the IBPs they leave exposed become SBPs,
@@ -292,6 +315,7 @@ class PhaseChange final : public Module {
     long melted_total_ = 0;
     long lattice_particles_ = 0;               // of the melting objects, at the start
     int full_ring_ = 26;                       // a vertex's one-ring neighbours: 26, or 8 in 2D
+    Real sheet_below_ = 0;                     // m: a vertex summing less is met from all round
     std::vector<MeltingGrid> grids_;           // per melting object: its lattice's grid
 };
 

@@ -16,6 +16,7 @@
 
 #include "algorithms/coupling.hpp"
 #include "algorithms/lsm.hpp"
+#include "algorithms/melting_faces.hpp"
 #include "algorithms/module.hpp"
 #include "algorithms/particle_store.hpp"
 #include "algorithms/particle_types.hpp"
@@ -196,6 +197,12 @@ class SolidBodies final : public Module {
             melting_.push_back(MeltingLattice{o, ibp_begin[o], solid.lattice, solid.region_half_width});
         }
         if (!melting_.empty()) host_layout_ = std::move(L);
+        // The correction against the melting lattices' exposed vertices (melting_faces.hpp):
+        // their normals, and two-way their contact masses and impulses, by IBP slot.
+        lattice_normal_.assign(!melting_.empty() && setup.params.coupling.correction ? ibp_count_ : 0, Vec3{0, 0, 0});
+        const bool lattice_takes_impulses = !lattice_normal_.empty() && !reaction_.empty();
+        lattice_inverse_mass_.assign(lattice_takes_impulses ? ibp_count_ : 0, Real(0));
+        lattice_impulse_.assign(lattice_takes_impulses ? ibp_count_ : 0, Vec3{0, 0, 0});
     }
 
     // A melting object's lattice: its index in the setup's solids, its first IBP slot, its
@@ -244,6 +251,7 @@ class SolidBodies final : public Module {
     View<std::uint32_t> slot_map() { return store_of_slot_.view(); }
     void slot_map_fill(std::uint32_t value) { store_of_slot_.fill(value); }
     View<const std::int32_t> slot_objects() const { return object_.cview(); }
+    View<const std::uint8_t> pinned_slots() const { return pinned_.cview(); }  // per IBP slot
     DeviceArray<std::int32_t>& solid_slot_field() { return *solid_slot_; }
     View<const std::int32_t> solid_slot_view() const { return solid_slot_ ? solid_slot_->cview() : View<const std::int32_t>{}; }
     // The slots of the particles that meet the fluid: the IBPs, then the SBPs.
@@ -455,6 +463,7 @@ class SolidBodies final : public Module {
         c.share_sbp = share_sbp_.view().data();
         c.share_weight = share_weight_.view().data();
         if (!sbp_impulse_.empty()) c.sbp_contact_impulse = sbp_impulse_.view().data();
+        if (!lattice_impulse_.empty()) c.lattice_contact_impulse = lattice_impulse_.view().data();
         if (!sbp_eta_.empty()) c.sbp_eta = sbp_eta_.view().data();
         c.faces = sbp_faces();
         return c;
@@ -467,9 +476,13 @@ class SolidBodies final : public Module {
         c.grid = grid;
         c.type = store.type.cview();
         c.solid_slot = solid_slot_->cview();
-        c.sbp_normal = sbp_normal_.view().data();
+        if (sbp_count_ > 0) c.sbp_normal = sbp_normal_.view().data();
         c.sbp_inset = sbp_faces().inset;
         if (!sbp_sides_.empty()) c.sbp_sides = sbp_sides_.view().data();
+        if (!sbp_inverse_mass_.empty()) c.sbp_inverse_mass = sbp_inverse_mass_.view().data();
+        if (!lattice_normal_.empty()) c.lattice_normal = lattice_normal_.view().data();
+        if (!lattice_inverse_mass_.empty()) c.lattice_inverse_mass = lattice_inverse_mass_.view().data();
+        c.lattice_inset = Real(0.5) * reach;
         c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
         c.sbp_count = static_cast<std::uint32_t>(sbp_count_);
         c.band = band;
@@ -484,18 +497,24 @@ class SolidBodies final : public Module {
         SolidContactData c;
         c.surface = surface;
         c.store_of_slot = store_of_slot_.view().data();
-        if (!sbp_impulse_.empty()) {
-            c.sbp_inverse_mass = sbp_inverse_mass_.view().data();
-            c.sbp_impulse = sbp_impulse_.view().data();
-            c.impulse_per_weight = impulse_per_weight;
-        }
+        if (!sbp_impulse_.empty()) c.sbp_impulse = sbp_impulse_.view().data();
+        if (!lattice_impulse_.empty()) c.lattice_impulse = lattice_impulse_.view().data();
+        if (contact_takes_impulses()) c.impulse_per_weight = impulse_per_weight;
         c.slip = slip;
         c.fluid_inverse_mass = Real(1) / fluid_mass;
         return c;
     }
     // Whether the correction exchanges momentum with the solids (two-way coupling and the
     // correction on).
-    bool contact_takes_impulses() const { return !sbp_impulse_.empty(); }
+    bool contact_takes_impulses() const { return !sbp_impulse_.empty() || !lattice_impulse_.empty(); }
+    // The melting lattices' exposed vertices as the correction meets them, by IBP slot, for the
+    // melting module to fill each step (melting_faces.hpp); null normals: not met.
+    LatticeFaceArrays lattice_faces() {
+        LatticeFaceArrays f;
+        if (!lattice_normal_.empty()) f.normal = lattice_normal_.view().data();
+        if (!lattice_inverse_mass_.empty()) f.inverse_mass = lattice_inverse_mass_.view().data();
+        return f;
+    }
     // Interface tension (interface_tension.hpp): whether any object has it, and its eta per SBP.
     bool has_tension() const { return !sbp_eta_.empty(); }
     const Real* sbp_eta() const { return sbp_eta_.empty() ? nullptr : sbp_eta_.view().data(); }
@@ -512,8 +531,14 @@ class SolidBodies final : public Module {
     // the next step's coupling applies (kg m/s, summed in double on the host; 0 without it). For
     // tests: momentum is kept only counting it.
     std::vector<std::array<double, 3>> object_contact_impulses() const {
-        if (sbp_impulse_.empty()) return sum_by_object({}, {});
-        return sum_by_object(sbp_impulse_.to_host(), sbp_object_);
+        std::vector<std::array<double, 3>> total = sum_by_object(sbp_impulse_.to_host(), sbp_object_);
+        if (!lattice_impulse_.empty()) {
+            const std::vector<std::int32_t> slot_object = object_.to_host();  // IBP slots first
+            const std::vector<std::array<double, 3>> lattice = sum_by_object(lattice_impulse_.to_host(), slot_object);
+            for (std::size_t o = 0; o < total.size(); ++o)
+                for (int a = 0; a < 3; ++a) total[o][a] += lattice[o][a];
+        }
+        return total;
     }
     View<const Vec3> sbp_normals() const { return sbp_normal_.cview(); }
     // Where the SBPs meet the fluid (solid_face.hpp), and whether any sits inside its face.
@@ -521,6 +546,8 @@ class SolidBodies final : public Module {
         return SbpFaces{sbp_normal_.view().data(), sbp_inset_.empty() ? nullptr : sbp_inset_.view().data()};
     }
     bool surface_inset() const { return !sbp_inset_.empty(); }
+    // Whether the correction meets melting lattices, whose faces lie in front of their vertices.
+    bool lattice_faces_met() const { return !lattice_normal_.empty(); }
 
     // Checkpoints (state_archive.hpp): what the solids carry from one step to the next. The
     // layout (rest shape, regions, links) is rebuilt from the scene; this is the rest: the
@@ -550,7 +577,8 @@ class SolidBodies final : public Module {
                region_acceleration_.bytes() + region_angular_acceleration_.bytes() +
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + sbp_sides_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
-               share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + sbp_eta_.bytes() +
+               share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + lattice_normal_.bytes() +
+               lattice_inverse_mass_.bytes() + lattice_impulse_.bytes() + sbp_eta_.bytes() +
                object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes() +
                body_motion_.bytes() + contact_.bytes();
     }
@@ -666,6 +694,7 @@ class SolidBodies final : public Module {
         visit("solids.sbp_normal", self.sbp_normal_);
         visit("solids.sbp_inset", self.sbp_inset_);
         visit("solids.sbp_impulse", self.sbp_impulse_);
+        visit("solids.lattice_impulse", self.lattice_impulse_);
     }
 
     // Per-particle vectors summed in double per object (indexed like SimulationSetup::solids).
@@ -732,6 +761,9 @@ class SolidBodies final : public Module {
     // The velocity–position correction under two-way coupling (solid_contact.hpp): per SBP.
     DeviceArray<Real> sbp_inverse_mass_;
     DeviceArray<Vec3> sbp_impulse_;
+    DeviceArray<Vec3> lattice_normal_;        // per IBP slot, with a melting object (melting_faces.hpp)
+    DeviceArray<Real> lattice_inverse_mass_;  // per IBP slot, the same, two-way
+    DeviceArray<Vec3> lattice_impulse_;       // per IBP slot, the same, two-way
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
     DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity

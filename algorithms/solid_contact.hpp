@@ -22,7 +22,8 @@
 // force goes to IBPs d by the shares w_sd (coupling.hpp); a force F on IBP d, split among its n_d
 // regions and moving each region r (mass M_r) as a rigid body, accelerates d by
 // F Σ_r (1/M_r) / n_d², so 1/m_d = Σ_r (1/M_r) / n_d² (a rigid object's one region: 1/M), and the
-// SBP's 1/m_s = Σ_d w_sd / m_d. Rotation is left out: an off-centre hit on a rigid body moves the
+// SBP's 1/m_s = Σ_d w_sd / m_d (a melting lattice's exposed vertex is an IBP: its own 1/m_d,
+// melting_faces.hpp). Rotation is left out: an off-centre hit on a rigid body moves the
 // point a little more than this says. Pinned IBPs are infinitely heavy. One-way coupling: every
 // SBP is (the solid feels nothing), and no impulse is kept.
 //
@@ -70,9 +71,11 @@ MW_BACKEND_BEGIN
 struct SolidContactData {
     SolidSurface surface;
     const std::uint32_t* store_of_slot = nullptr;
-    const Real* sbp_inverse_mass = nullptr;  // null: one-way, every SBP infinitely heavy
     Vec3* impulse_per_weight = nullptr;      // per fluid particle, J / Σ w (two-way only)
     Vec3* sbp_impulse = nullptr;             // per SBP, what it got in this step (two-way only)
+    // Per IBP slot, what a melting lattice's exposed vertex got in this step (two-way, with a
+    // melting object only).
+    Vec3* lattice_impulse = nullptr;
     Real slip = 1;                           // ∂: 0 no-slip, 1 free slip
     Real fluid_inverse_mass = 0;             // 1 / m_i
     Real dt = 0;                             // the step: a particle started it at x - dt v
@@ -89,7 +92,7 @@ inline void correct_fluid_at_solids(const DeviceContext& device, std::size_t flu
     parallel_for(device, "solid_contact_fluid", fluid_count, [=] MW_HD(std::size_t i) {
         const Vec3 x = position[i], v = velocity[i];
         const VirtualBoundary k = d.surface.collide(static_cast<std::uint32_t>(i), x, x - d.dt * v, position,
-                                                    velocity, d.sbp_inverse_mass);
+                                                    velocity, d.impulse_per_weight != nullptr);
         Vec3 xc = x, vc = v, impulse{0, 0, 0};
         Real depth = 0;
         if (d.surface.collides(k, x, v, depth)) {
@@ -127,6 +130,25 @@ inline void gather_sbp_impulses(const DeviceContext& device, std::size_t fluid_e
             });
         }
         d.sbp_impulse[k] = sum;
+    });
+}
+
+// Per IBP slot (two-way, with a melting object): an exposed lattice vertex's shares, as the SBPs'
+// above; the other slots get none.
+inline void gather_lattice_impulses(const DeviceContext& device, std::size_t fluid_end, std::size_t solid_end,
+                                    View<const Vec3> position, const SolidContactData d) {
+    parallel_for(device, "solid_contact_lattice", d.surface.ibp_count, [=] MW_HD(std::size_t s) {
+        const SolidSurface& surface = d.surface;
+        const std::uint32_t b = d.store_of_slot[s];
+        Vec3 sum{0, 0, 0};
+        if (b >= fluid_end && b < solid_end && surface.type[b] == kSurfaceBoundary) {
+            const Vec3 xs = surface.lattice_face(position[b], static_cast<std::uint32_t>(s));
+            surface.grid.for_each_fluid_around_particle(b, [&](std::uint32_t i) {
+                const Real w = contact_weight(position[i], xs, surface.reach);
+                if (w > Real(0)) sum += w * d.impulse_per_weight[i];
+            });
+        }
+        d.lattice_impulse[s] = sum;
     });
 }
 

@@ -27,7 +27,7 @@ class SolidCorrection final : public Module {
             throw InputError("simulation setup: the solids' slip factor must be in [0, 1]");
         if (!active_) return;
         const std::size_t moving = state.store.moving_count();
-        band_ = static_cast<Real>(moving_solid_contact(solids.surface_inset()) * state.params.fluid.spacing);
+        band_ = static_cast<Real>(moving_solid_contact(solids.surface_inset() || solids.lattice_faces_met()) * state.params.fluid.spacing);
         near_solid_.resize(moving);
         if (solids.contact_takes_impulses()) impulse_per_weight_.resize(moving);
     }
@@ -60,8 +60,12 @@ class SolidCorrection final : public Module {
             View<Vec3> corrected_velocity = fluid_.scratch_after_integration(1);
             correct_fluid_at_solids(state_.device, fluid_count, store.position.cview(), store.velocity.cview(),
                                     corrected_position, corrected_velocity, contact, walls_.walls());
-            gather_sbp_impulses(state_.device, step.ranges.fluid_end, step.ranges.solid_end, store.position.cview(),
-                                contact);
+            if (contact.sbp_impulse)
+                gather_sbp_impulses(state_.device, step.ranges.fluid_end, step.ranges.solid_end, store.position.cview(),
+                                    contact);
+            if (contact.lattice_impulse)
+                gather_lattice_impulses(state_.device, step.ranges.fluid_end, step.ranges.solid_end,
+                                        store.position.cview(), contact);
             apply_fluid_correction(state_.device, fluid_count, corrected_position, corrected_velocity,
                                    store.position.view(), store.velocity.view());
         } else {

@@ -16,9 +16,9 @@ struct StageInfo {
 };
 
 inline constexpr StageInfo kStepStages[] = {
-    {"neighbors", "neighbor_search, solid_correction", "always",
+    {"neighbors", "neighbor_search, solid_correction, melting", "always",
      "sorts the moving particles by cell and permutes every field; neighbour lists (OpenMP); which fluid is near "
-     "a moving solid"},
+     "a moving solid; the melting lattices' faces"},
     {"solid_volumes", "boundary_volumes, solids, coupling", "fluid and moving solids",
      "Akinci volumes of the moving solids' boundary particles; where the solids will be at the step's end; the rigid "
      "objects' answer inside PCISPH (coupling.strong)"},

@@ -25,6 +25,12 @@
 // without it. The cost, in fluid thrown at a cube at 4-6 times the CFL step: more particles get
 // in than with P (docs/coupling.md).
 //
+// A melting object's exposed lattice vertices (IBP slots with the SBP type) count in S as SBPs do,
+// each standing for its cell's face r0/2 in front of it along the normal melting_faces.hpp reads
+// from the lattice, or for the vertex itself, met from all round, where it has no outside. A
+// virtual particle with lattice faces in it whose normals sum to less than kOpposedFaces of their
+// weight lies between two faces that look at each other: none.
+//
 // k's surface is a disc of radius kSurfacePatchRadius r0 round x_k in k's plane: a particle
 // beside the disc (past an edge of the object, where S holds only the SBPs nearest the edge) is
 // as far from the surface as from the disc's rim, not as far as from the plane.
@@ -59,6 +65,9 @@ MW_INLINE Real contact_weight(Vec3 x, Vec3 xs, Real reach) {
 // (sampling/surface_sampler.hpp). Measured on scenes/floating_boxes.json to t = 1 s (top fluid
 // speed; 1.02 m/s without the correction): 1.22 m/s at r0/2, and 3.51 m/s with the plane alone.
 constexpr double kSurfacePatchRadius = 0.5;
+// A virtual particle built from melting lattices' faces whose weighted normals sum to less than
+// this share of their weight is between opposed faces: none.
+constexpr double kOpposedFaces = 0.5;
 
 struct VirtualBoundary {
     Real weight = 0;  // Σ w_s; 0: no SBP within r0
@@ -93,6 +102,16 @@ struct SolidSurface {
     // rod's from all round); null: every SBP from outside its face. Its normal turns toward where
     // the fluid particle comes from (`from` of collide).
     const std::uint8_t* sbp_sides = nullptr;
+    // By SBP index, the inverse contact masses (solid_contact.hpp); null: every SBP infinitely
+    // heavy (one-way coupling).
+    const Real* sbp_inverse_mass = nullptr;
+    // A melting object's exposed lattice vertices (IBP slots with the SBP type; melting_faces.hpp),
+    // by IBP slot: the outward normal, zero where the fluid meets the vertex from all round (one
+    // with vertices left on opposite sides: a one-layer sheet or a lone vertex), and the inverse
+    // contact mass (two-way). Null: a scene with no melting object, or the correction off.
+    const Vec3* lattice_normal = nullptr;
+    const Real* lattice_inverse_mass = nullptr;
+    Real lattice_inset = 0;  // m: a vertex's face lies this far in front of it (r0/2: its cell's face)
     std::uint32_t ibp_count = 0, sbp_count = 0;  // SBP k has solid slot ibp_count + k
     Real band = 0;   // c, m
     Real reach = 0;  // r0, m
@@ -104,38 +123,65 @@ struct SolidSurface {
     // solids, as most fluid is, the rule then costs one byte read per prediction, not a gather.
     const std::uint8_t* fluid_near_solid = nullptr;
 
-    MW_INLINE bool active() const { return sbp_normal != nullptr; }
+    MW_INLINE bool active() const { return sbp_normal != nullptr || lattice_normal != nullptr; }
     MW_INLINE SbpFaces faces() const { return SbpFaces{sbp_normal, sbp_inset}; }
+    // Where a melting lattice's exposed vertex at x, IBP slot s, meets the fluid: its cell's face
+    // in front of it, or the vertex itself where it has no outside (melting_faces.hpp).
+    MW_INLINE Vec3 lattice_face(Vec3 x, std::uint32_t s) const { return x + lattice_inset * lattice_normal[s]; }
 
     // The virtual particle fluid particle i at x faces: a gather over the SBPs around the cell i
     // was sorted into at this step's build (neighbor_grid.hpp), from the store's positions and
     // velocities. A virtual particle whose normals cancel is none. `from`: where i was at the
     // start of the step, which decides the side of a two-sided SBP it meets and the direction
     // round a rod's. The paper turns a cloth's normal along x_is = x_i - x_s; a particle that has
-    // already crossed the sheet in this step would then be pushed on through it.
+    // already crossed the sheet in this step would then be pushed on through it. `masses`: sum the
+    // contact masses (two-way), else k is infinitely heavy.
     MW_INLINE VirtualBoundary collide(std::uint32_t i, Vec3 x, Vec3 from, View<const Vec3> position,
-                                      View<const Vec3> velocity, const Real* sbp_inverse_mass) const {
+                                      View<const Vec3> velocity, bool masses) const {
         VirtualBoundary k;
         if (fluid_near_solid && !fluid_near_solid[i]) return k;
         Vec3 normal_sum{0, 0, 0};
+        Real lattice_weight = 0;
         grid.for_each_solid_around_particle(i, [&](std::uint32_t j) {
-            // A melting object's SBPs are lattice vertices (IBP slots) with no surface normal:
-            // not in the correction yet (docs/melting.md).
-            if (type[j] != kSurfaceBoundary || std::uint32_t(solid_slot[j]) < ibp_count) return;
+            if (type[j] != kSurfaceBoundary) return;
+            const std::uint32_t slot = std::uint32_t(solid_slot[j]);
             const Vec3 sbp = position[j];
-            if (!(norm2(x - sbp) < sbp_reach * sbp_reach)) return;
-            const std::uint32_t s = static_cast<std::uint32_t>(solid_slot[j]) - ibp_count;
-            const Vec3 xs = faces().at(sbp, s);
+            Vec3 xs = sbp, normal{0, 0, 0};
+            Real inverse_mass = 0;
+            if (slot < ibp_count) {
+                // A melting lattice's exposed vertex.
+                if (!lattice_normal) return;
+                xs = lattice_face(sbp, slot);
+                const Real w = contact_weight(x, xs, reach);
+                if (!(w > Real(0))) return;
+                const Vec3 stored = lattice_normal[slot];
+                normal = sbp_normal_toward(stored, norm2(stored) > Real(0) ? kSbpOneSided : kSbpAround, from - sbp);
+                if (masses) inverse_mass = lattice_inverse_mass[slot];
+                k.weight += w;
+                k.position += w * xs;
+                k.velocity += w * velocity[j];
+                normal_sum += w * normal;
+                k.inverse_mass += w * inverse_mass;
+                lattice_weight += w;
+                return;
+            }
+            if (!sbp_normal || !(norm2(x - sbp) < sbp_reach * sbp_reach)) return;
+            const std::uint32_t s = slot - ibp_count;
+            xs = faces().at(sbp, s);
             const Real w = contact_weight(x, xs, reach);
             if (!(w > Real(0))) return;
             k.weight += w;
             k.position += w * xs;
             k.velocity += w * velocity[j];
             normal_sum += w * (sbp_sides ? sbp_normal_toward(sbp_normal[s], sbp_sides[s], from - sbp) : sbp_normal[s]);
-            if (sbp_inverse_mass) k.inverse_mass += w * sbp_inverse_mass[s];
+            if (masses) k.inverse_mass += w * sbp_inverse_mass[s];
         });
         const Real length = norm(normal_sum);
         if (!(k.weight > Real(0)) || !(length > Real(0))) return VirtualBoundary{};
+        // Between two lattice faces that look at each other (a one-layer melt in a gap), the
+        // mean face would lie between them, beside the particle: no collision (the pressure keeps
+        // it there).
+        if (lattice_weight > Real(0) && length < Real(kOpposedFaces) * k.weight) return VirtualBoundary{};
         const Real inv_w = Real(1) / k.weight;
         k.position = inv_w * k.position;
         k.velocity = inv_w * k.velocity;
@@ -157,7 +203,7 @@ struct SolidSurface {
     // density sees them): x* moves along n_k until it is c in front of k's surface.
     MW_INLINE Vec3 correct_predicted(std::uint32_t i, Vec3 x, Vec3 from, Vec3 v, View<const Vec3> position,
                                      View<const Vec3> velocity) const {
-        const VirtualBoundary k = collide(i, x, from, position, velocity, nullptr);
+        const VirtualBoundary k = collide(i, x, from, position, velocity, false);
         Real depth = 0;
         return collides(k, x, v, depth) ? x + (band - depth) * k.normal : x;
     }

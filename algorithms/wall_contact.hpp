@@ -120,7 +120,8 @@ constexpr double kMovingSolidContact = kStaticObjectContact;
 // moves resting fluid every step (docs/coupling.md).
 constexpr double kInsetSolidContact = 0.3;
 // The band against the moving objects' SBPs, in r0: one for the whole scene, the narrower one
-// when any SBP sits inside its face (SimulationSetup::any_sbp_set_in; SolidBodies::surface_inset
+// when any SBP sits inside its face or a melting lattice's faces are met, r0/2 in front of its
+// vertices (SimulationSetup::narrow_solid_band; SolidBodies::surface_inset and lattice_faces_met
 // on the device side), so that `meltwater info` and the correction agree.
 constexpr double moving_solid_contact(bool any_sbp_set_in) {
     return any_sbp_set_in ? kInsetSolidContact : kMovingSolidContact;

@@ -290,7 +290,7 @@ void print_coupling(const InfoFacts& f) {
     if (c.correction)
         std::printf("            velocity-position correction against them on (coupling.correction): fluid moving into "
                     "one stops %.2f r0 from its surface%s, slip %g\n",
-                    moving_solid_contact(set_in),
+                    moving_solid_contact(f.setup.narrow_solid_band()),
                     c.two_way ? " and trades momentum with it" : " and takes its velocity", double(c.slip));
     else
         std::printf("            velocity-position correction against them off (coupling.correction false)\n");

@@ -124,6 +124,14 @@ struct SimulationSetup {
                 if (inset > Real(0)) return true;
         return false;
     }
+    // Whether the correction meets the moving objects with the narrower band: an SBP set in, or a
+    // melting object, whose faces lie half a spacing in front of its vertices
+    // (algorithms/melting_faces.hpp).
+    bool narrow_solid_band() const {
+        for (const SolidSetup& s : solids)
+            if (s.melts()) return true;
+        return any_sbp_set_in();
+    }
 };
 
 // The particle state copied back to the host for output.

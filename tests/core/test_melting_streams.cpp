@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "apps/scene.hpp"
 #include "apps/scene_builder.hpp"
@@ -27,11 +28,20 @@ struct Census {
     std::array<long, kCubes> left{};        // each cube's particles not melted
     std::array<double, kCubes> centre_y{};  // their mean height, m
     long fluid = 0;
+    long inside = 0;     // fluid particles within r0/2 of a cube's lattice vertex: in its cell
     double fastest = 0;  // m/s, any particle
 };
 
 Census census(const HostParticles& p) {
     Census c;
+    std::vector<Vec3> lattice;
+    for (std::size_t i = 0; i < p.type.size(); ++i)
+        if (p.type[i] != kFluid && p.object[i] >= 0 && p.object[i] < kCubes) lattice.push_back(p.position[i]);
+    const Real half_r0 = Real(0.01);
+    for (std::size_t i = 0; i < p.type.size(); ++i)
+        if (p.type[i] == kFluid)
+            c.inside += std::any_of(lattice.begin(), lattice.end(),
+                                    [&](const Vec3& b) { return norm2(b - p.position[i]) < half_r0 * half_r0; });
     for (std::size_t i = 0; i < p.type.size(); ++i) {
         c.fastest = std::max(c.fastest, double(norm(p.velocity[i])));
         if (p.type[i] == kFluid) ++c.fluid;
@@ -59,6 +69,7 @@ TEST_CASE("Four cubes under warm streams (Fig. 11b) melt in the order their cond
     // To the streams' end (2 s), looking every 0.25 s.
     Census now = start;
     double fastest = 0;
+    long most_inside = 0;
     bool green_ahead = true;  // the green cube has melted at least as much as the blue one at every look
     for (double look = 0.25; look <= 2.0 + 1e-9; look += 0.25) {
         while (sim->time() < look - 1e-9) {
@@ -68,9 +79,11 @@ TEST_CASE("Four cubes under warm streams (Fig. 11b) melt in the order their cond
         sim->download(p);
         now = census(p);
         fastest = std::max(fastest, now.fastest);
+        most_inside = std::max(most_inside, now.inside);
         green_ahead = green_ahead && now.left[0] <= now.left[3];
         MESSAGE("t " << sim->time() << " s: left " << now.left[0] << ", " << now.left[1] << ", " << now.left[2] << ", "
-                     << now.left[3] << "; fastest " << now.fastest << " m/s");
+                     << now.left[3] << "; fastest " << now.fastest << " m/s; " << now.inside
+                     << " fluid particles inside a lattice");
     }
     const StepReport& last = sim->last_report();
     long left = 0;
@@ -79,11 +92,14 @@ TEST_CASE("Four cubes under warm streams (Fig. 11b) melt in the order their cond
     CHECK(last.lost_particles == 0);
     CHECK(long(last.value("melted")) == kCubes * kParticlesPerCube - left);
     CHECK(now.fluid == long(last.value("emitted")) + long(last.value("melted")));
-    // Measured (EPYC VM): green gone by 1.25 s; at 2 s, 95, 86 and 31 particles left of red,
-    // yellow and blue.
+    // Measured (EPYC VM): green gone by 1.5 s; at 2 s, 100, 100 and 67 particles left of red,
+    // yellow and blue. Without the correction against the lattices' faces (coupling.correction
+    // off) fluid gets into them (21 particles at once) and warms them from inside: 95, 86 and 31
+    // left.
     CHECK(now.left[0] == 0);
     CHECK(green_ahead);
-    CHECK(now.left[3] < kParticlesPerCube / 2);
+    CHECK(now.left[3] < kParticlesPerCube * 3 / 4);
+    CHECK(most_inside <= 4);
     CHECK(now.left[1] > now.left[3]);
     CHECK(now.left[2] > now.left[3]);
     CHECK(now.left[1] > kParticlesPerCube / 2);

@@ -397,7 +397,8 @@ struct CubeThrow {
     SimulationSetup setup;
     double fluid_mass = 0, ibp_mass = 0;  // kg per fluid particle and per IBP
 
-    CubeThrow(SolidKind kind, Real speed, Real dt) {
+    // `melting`: a melting object's lattice alone, far below its melting point (heat on).
+    CubeThrow(SolidKind kind, Real speed, Real dt, bool melting = false) {
         setup = fluid_in_box({0, 0, 0}, {0.8f, 0.4f, 0.4f}, {0.1f, 0.14f, 0.14f}, {0.22f, 0.26f, 0.26f}, r0, dt,
                              /*walls=*/false);
         setup.params.gravity = Vec3{0, 0, 0};
@@ -407,7 +408,13 @@ struct CubeThrow {
         solid.kind = kind;
         solid.density = 1000;
         solid.stiffness = 0.5f;
+        if (melting) {
+            setup.params.heat.enabled = true;
+            solid.melting_point = Real(1e4);
+            solid.latent_heat = Real(1e12);
+        }
         add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.22 + 2 * r0 + 0.06, 0.2, 0.2), solid, Vec3{0, 0, 0});
+        if (melting) setup.temperature.assign(setup.position.size(), Real(20));
         fluid_mass = lattice_mass(CubicSpline3D::with_support(2 * r0), r0, 1000.0);
         ibp_mass = solid.density * double(r0) * r0 * r0;
     }
