@@ -11,7 +11,7 @@
 //   content heat.hpp conserves. Below T_m an absorbed store flows back into T first (refreezing).
 // - Phase change. An SBP at T_m whose store has reached L ρ / C melts: it becomes a fluid particle
 //   (type, no slot, no object, the fluid's rest density as its last density) with the velocity
-//   it had, and what it absorbed past the latent heat returns to its temperature (scaled by the
+//   it had (and, two-way, the correction's impulse of the step in it as J / m, melting_faces.hpp), and what it absorbed past the latent heat returns to its temperature (scaled by the
 //   object's heat capacity over the fluid's, so that it stays the same heat per volume). Only
 //   SBPs melt, so an object melts from the outside in.
 // - Its neighbours lose it: a vertex left with fewer than 26 one-ring neighbours becomes an SBP,
@@ -103,8 +103,9 @@ class PhaseChange final : public Module {
     // store field `latent_heat` (K, 0 to start). Throws InputError for a melting object that is not
     // elastic, or melting without heat conduction.
     PhaseChange(const DeviceContext& device, const SimulationSetup& setup, ParticleStore& store, SolidBodies& solids,
-                ParticleCounts& counts, Real rest_density)
-        : device_(device), store_(store), solids_(solids), counts_(counts), rest_density_(rest_density) {
+                ParticleCounts& counts, Real rest_density, Real fluid_mass)
+        : device_(device), store_(store), solids_(solids), counts_(counts), rest_density_(rest_density),
+          fluid_mass_(fluid_mass) {
         std::vector<MeltingPoint> points(setup.solids.size());
         bool any = false;
         for (std::size_t o = 0; o < setup.solids.size(); ++o) {
@@ -253,6 +254,9 @@ class PhaseChange final : public Module {
         p.object = store.object.view().data();
         p.density = store.density.view().data();
         p.rest_density = rest_density;
+        p.lattice_impulse = solids.lattice_faces().impulse;
+        p.velocity = store.velocity.view().data();
+        p.inverse_fluid_mass = Real(1) / fluid_mass_;
         for (const MeltingGrid& g : grids_) update_melting_lattice(device_, g, l);
         melted_total_ += counts.melted;
         counts.exposed = count_exposed();
@@ -303,6 +307,7 @@ class PhaseChange final : public Module {
     SolidBodies& solids_;
     ParticleCounts& counts_;
     Real rest_density_ = 0;
+    Real fluid_mass_ = 0;  // kg, a fluid particle's: what a melted vertex weighs
     DeviceArray<Real>* temperature_ = nullptr;  // the heat's store field
     std::size_t ibp_count_ = 0;
     DeviceArray<MeltingPoint> points_;         // per object

@@ -28,6 +28,7 @@ MW_BACKEND_BEGIN
 struct LatticeFaceArrays {
     Vec3* normal = nullptr;        // null: the correction does not meet the lattices
     Real* inverse_mass = nullptr;  // null: one-way, the lattices infinitely heavy
+    Vec3* impulse = nullptr;       // what each took in the last correction (two-way)
 };
 
 // What the faces are read from.

@@ -53,6 +53,12 @@ struct PhaseChangeData {
     std::int32_t* object = nullptr;
     Real* density = nullptr;
     Real rest_density = 0;
+    // The impulses the correction gave the exposed vertices in this step (melting_faces.hpp), per
+    // IBP slot, which the next step's coupling would apply: a vertex that melts takes its own
+    // into its velocity as fluid. Null: none (one-way, or the correction off).
+    Vec3* lattice_impulse = nullptr;
+    Vec3* velocity = nullptr;  // store field
+    Real inverse_fluid_mass = 0;
 };
 // The per-step state of the melting lattices and the region arrays the rebuild writes.
 struct MeltingLatticeData {
@@ -111,6 +117,10 @@ inline void melting_phase_change(const DeviceContext& device, const MeltingGrid 
         p.object[i] = -1;
         p.density[i] = p.rest_density;
         p.store_of_slot[s] = kMeltedSlot;
+        if (p.lattice_impulse) {
+            p.velocity[i] += p.inverse_fluid_mass * p.lattice_impulse[s];
+            p.lattice_impulse[s] = Vec3{0, 0, 0};
+        }
     });
     parallel_for(device, "melting_exposed", g.count, [=] MW_HD(std::size_t k) {
         const std::uint32_t s = g.base + std::uint32_t(k);

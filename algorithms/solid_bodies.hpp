@@ -513,6 +513,7 @@ class SolidBodies final : public Module {
         LatticeFaceArrays f;
         if (!lattice_normal_.empty()) f.normal = lattice_normal_.view().data();
         if (!lattice_inverse_mass_.empty()) f.inverse_mass = lattice_inverse_mass_.view().data();
+        if (!lattice_impulse_.empty()) f.impulse = lattice_impulse_.view().data();
         return f;
     }
     // Interface tension (interface_tension.hpp): whether any object has it, and its eta per SBP.

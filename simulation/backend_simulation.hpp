@@ -255,7 +255,7 @@ void BackendSimulation<Kernel>::build_modules(const SimulationSetup& setup, cons
     });
     BoundaryVolumes<Kernel>& volumes = add<BoundaryVolumes<Kernel>>(state_, setup, solids.active(), params_.heat.enabled);
     HeatConduction<Kernel>& heat = add<HeatConduction<Kernel>>(state_, setup, order, volumes, solids);
-    add<PhaseChange>(device_, setup, store, solids, state_.counts, params_.fluid.rest_density);
+    add<PhaseChange>(device_, setup, store, solids, state_.counts, params_.fluid.rest_density, state_.fluid.mass);
     add<FluidEmitters>(device_, setup, store, state_.counts, params_.fluid.rest_density, params_.gravity);
     search.sort_static();
     const WallCorrection& walls = add<WallCorrection>(params_, has_fluid);

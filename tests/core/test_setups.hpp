@@ -397,8 +397,11 @@ struct CubeThrow {
     SimulationSetup setup;
     double fluid_mass = 0, ibp_mass = 0;  // kg per fluid particle and per IBP
 
-    // `melting`: a melting object's lattice alone, far below its melting point (heat on).
-    CubeThrow(SolidKind kind, Real speed, Real dt, bool melting = false) {
+    // The cube as a melting object's lattice alone (heat on): kNone a mesh's object; kWhole far
+    // below its melting point; kMelting at it, with the fluid's particle mass, in fluid at 20 °C,
+    // so that what the fluid touches melts.
+    enum class Lattice { kNone, kWhole, kMelting };
+    CubeThrow(SolidKind kind, Real speed, Real dt, Lattice lattice = Lattice::kNone) {
         setup = fluid_in_box({0, 0, 0}, {0.8f, 0.4f, 0.4f}, {0.1f, 0.14f, 0.14f}, {0.22f, 0.26f, 0.26f}, r0, dt,
                              /*walls=*/false);
         setup.params.gravity = Vec3{0, 0, 0};
@@ -408,14 +411,18 @@ struct CubeThrow {
         solid.kind = kind;
         solid.density = 1000;
         solid.stiffness = 0.5f;
-        if (melting) {
+        fluid_mass = lattice_mass(CubicSpline3D::with_support(2 * r0), r0, 1000.0);
+        if (lattice != Lattice::kNone) {
             setup.params.heat.enabled = true;
-            solid.melting_point = Real(1e4);
-            solid.latent_heat = Real(1e12);
+            setup.params.heat.fluid_diffusivity = Real(0.01);
+            solid.thermal_diffusivity = Real(0.01);
+            solid.melting_point = Real(lattice == Lattice::kWhole ? 1e4 : 0);
+            solid.latent_heat = Real(lattice == Lattice::kWhole ? 1e12 : 2000);
+            if (lattice == Lattice::kMelting) solid.density = Real(fluid_mass / (double(r0) * r0 * r0));
         }
         add_box_solid(setup, Vec3d(0.12, 0.12, 0.12), Vec3d(0.22 + 2 * r0 + 0.06, 0.2, 0.2), solid, Vec3{0, 0, 0});
-        if (melting) setup.temperature.assign(setup.position.size(), Real(20));
-        fluid_mass = lattice_mass(CubicSpline3D::with_support(2 * r0), r0, 1000.0);
+        for (std::size_t i = 0; lattice != Lattice::kNone && i < setup.position.size(); ++i)
+            setup.temperature.push_back(Real(setup.object[i] < 0 ? 20 : 0));
         ibp_mass = solid.density * double(r0) * r0 * r0;
     }
     // Total momentum along x of the fluid and of the IBPs (SBPs and GPs carry no mass).
