@@ -11,8 +11,9 @@
 //   content heat.hpp conserves. Below T_m an absorbed store flows back into T first (refreezing).
 // - Phase change. An SBP at T_m whose store has reached L ρ / C melts: it becomes a fluid particle
 //   (type, no slot, no object, the fluid's rest density as its last density) with the velocity
-//   it had (and, two-way, the correction's impulse of the step in it as J / m, melting_faces.hpp), and what it absorbed past the latent heat returns to its temperature (scaled by the
-//   object's heat capacity over the fluid's, so that it stays the same heat per volume). Only
+//   it had (two-way, plus the correction's impulse of the step as J / m, melting_faces.hpp), and
+//   what it absorbed past the latent heat returns to its temperature (scaled by the object's heat
+//   capacity over the fluid's, so that it stays the same heat per volume). Only
 //   SBPs melt, so an object melts from the outside in.
 // - Its neighbours lose it: a vertex left with fewer than 26 one-ring neighbours becomes an SBP,
 //   and the object's regions are rebuilt over the vertices left (rebuild_elastic_object_regions;

@@ -1,7 +1,8 @@
 // What a melting lattice shows the fluid's velocity–position correction (solid_contact.hpp,
-// virtual_boundary.hpp; docs/melting.md, "The correction against a melting object"). A melting
-// object has no mesh surface: its SBPs are the lattice vertices that miss a one-ring neighbour
-// (melting.hpp), so the correction meets each of them on the vertex itself (no inset), with
+// virtual_boundary.hpp; docs/melting.md, "The correction against its faces"). A melting object
+// has no mesh surface: its SBPs are the lattice vertices that miss a one-ring neighbour
+// (melting.hpp), so the correction meets each at its cell's face, r0/2 in front of it along its
+// normal (SolidSurface::lattice_face), or on the vertex where it has no outside, with
 //   - a normal from the lattice as it stands: away from the vertices left in its one-ring,
 //     n = -Σ (x_j - x_i) / |Σ (x_j - x_i)| over the one-ring neighbours j still in the object,
 //     from the store's positions at the start of the step (where the density sees them), so

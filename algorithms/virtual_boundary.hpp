@@ -146,35 +146,29 @@ struct SolidSurface {
             if (type[j] != kSurfaceBoundary) return;
             const std::uint32_t slot = std::uint32_t(solid_slot[j]);
             const Vec3 sbp = position[j];
-            Vec3 xs = sbp, normal{0, 0, 0};
-            Real inverse_mass = 0;
-            if (slot < ibp_count) {
-                // A melting lattice's exposed vertex.
-                if (!lattice_normal) return;
-                xs = lattice_face(sbp, slot);
-                const Real w = contact_weight(x, xs, reach);
-                if (!(w > Real(0))) return;
-                const Vec3 stored = lattice_normal[slot];
-                normal = sbp_normal_toward(stored, norm2(stored) > Real(0) ? kSbpOneSided : kSbpAround, from - sbp);
-                if (masses) inverse_mass = lattice_inverse_mass[slot];
-                k.weight += w;
-                k.position += w * xs;
-                k.velocity += w * velocity[j];
-                normal_sum += w * normal;
-                k.inverse_mass += w * inverse_mass;
-                lattice_weight += w;
-                return;
-            }
-            if (!sbp_normal || !(norm2(x - sbp) < sbp_reach * sbp_reach)) return;
-            const std::uint32_t s = slot - ibp_count;
-            xs = faces().at(sbp, s);
+            // An IBP slot with the SBP type is a melting lattice's exposed vertex.
+            const bool lattice = slot < ibp_count;
+            const std::uint32_t s = lattice ? slot : slot - ibp_count;
+            if (lattice ? !lattice_normal : (!sbp_normal || !(norm2(x - sbp) < sbp_reach * sbp_reach))) return;
+            const Vec3 xs = lattice ? lattice_face(sbp, s) : faces().at(sbp, s);
             const Real w = contact_weight(x, xs, reach);
             if (!(w > Real(0))) return;
+            Vec3 normal;
+            Real inverse_mass = 0;
+            if (lattice) {
+                const Vec3 stored = lattice_normal[s];
+                normal = sbp_normal_toward(stored, norm2(stored) > Real(0) ? kSbpOneSided : kSbpAround, from - sbp);
+                if (masses) inverse_mass = lattice_inverse_mass[s];
+                lattice_weight += w;
+            } else {
+                normal = sbp_sides ? sbp_normal_toward(sbp_normal[s], sbp_sides[s], from - sbp) : sbp_normal[s];
+                if (masses) inverse_mass = sbp_inverse_mass[s];
+            }
             k.weight += w;
             k.position += w * xs;
             k.velocity += w * velocity[j];
-            normal_sum += w * (sbp_sides ? sbp_normal_toward(sbp_normal[s], sbp_sides[s], from - sbp) : sbp_normal[s]);
-            if (masses) k.inverse_mass += w * sbp_inverse_mass[s];
+            normal_sum += w * normal;
+            k.inverse_mass += w * inverse_mass;
         });
         const Real length = norm(normal_sum);
         if (!(k.weight > Real(0)) || !(length > Real(0))) return VirtualBoundary{};
