@@ -184,8 +184,8 @@ class PhaseChange final : public Module {
         if (solids_.lattice_faces().normal) plan.bind("neighbors", [this](StepContext&) { find_faces(); });
         plan.bind("melting", [this](StepContext&) { melt(); });
     }
-    // After the sort: the exposed vertices' normals and contact masses for the correction
-    // (melting_faces.hpp).
+    // After the sort: the exposed vertices' normals for the correction, and their contact masses
+    // where the regions changed since they were last found (melting_faces.hpp).
     void find_faces() {
         const MeltingRegionArrays r = solids_.melting_region_arrays();
         LatticeFaceInputs in;
@@ -201,7 +201,10 @@ class PhaseChange final : public Module {
         in.region_mass = r.region_mass;
         in.sheet_below = sheet_below_;
         const LatticeFaceArrays out = solids_.lattice_faces();
-        for (const MeltingGrid& g : grids_) melting_lattice_faces(device_, g, in, out);
+        for (const MeltingGrid& g : grids_) melting_lattice_normals(device_, g, in, out);
+        if (out.inverse_mass && contact_masses_stale_)
+            for (const MeltingGrid& g : grids_) melting_lattice_contact_masses(device_, g, in, out);
+        contact_masses_stale_ = false;
     }
     // Latent heat at the melting point, then the melting objects' SBPs that melt become fluid (the
     // next step's sort moves them to the fluid's range), the IBPs they leave exposed become SBPs,
@@ -259,6 +262,7 @@ class PhaseChange final : public Module {
         p.velocity = store.velocity.view().data();
         p.inverse_fluid_mass = Real(1) / fluid_mass_;
         for (const MeltingGrid& g : grids_) update_melting_lattice(device_, g, l);
+        contact_masses_stale_ = true;
         melted_total_ += counts.melted;
         counts.exposed = count_exposed();
         return counts;
@@ -281,6 +285,7 @@ class PhaseChange final : public Module {
         solids.rebuild_melting_regions(alive);
         solids.slot_map_fill(kMeltedSlot);
         solids.update_slot_map(store);
+        contact_masses_stale_ = true;
     }
 
     std::size_t bytes() const override {
@@ -322,6 +327,7 @@ class PhaseChange final : public Module {
     long lattice_particles_ = 0;               // of the melting objects, at the start
     int full_ring_ = 26;                       // a vertex's one-ring neighbours: 26, or 8 in 2D
     Real sheet_below_ = 0;                     // m: a vertex summing less is met from all round
+    bool contact_masses_stale_ = true;         // the regions or the exposed vertices changed since find_faces
     std::vector<MeltingGrid> grids_;           // per melting object: its lattice's grid
 };
 

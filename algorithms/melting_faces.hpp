@@ -13,8 +13,10 @@
 //   - two-way, a contact mass from the regions it is in as they stand after the last rebuild,
 //     1/m_d = Σ_r (1/M_r) / n_d² (solid_contact.hpp's rule for an IBP, which it is); a pinned
 //     vertex is infinitely heavy.
-// Both are per IBP slot and written every step for every vertex of a melting object (zero for the
-// inner ones and those gone), in stage "neighbors", after the sort.
+// Both are per IBP slot, for every vertex of a melting object (zero for the inner ones and those
+// gone): the normals every step in stage "neighbors", after the sort; the contact masses when the
+// regions or the exposed vertices change (the first step, a step where something melted, a
+// checkpoint's load), since nothing else moves them.
 #pragma once
 #include <cstdint>
 
@@ -51,41 +53,45 @@ struct LatticeFaceInputs {
 // each lie r0 behind its plane.
 constexpr double lattice_sheet_threshold(int full_ring) { return full_ring == 8 ? 1.5 : 4.5; }
 
-// One melting object's vertices: their normals and (two-way) contact masses (see the top of the file).
-inline void melting_lattice_faces(const DeviceContext& device, const MeltingGrid g, const LatticeFaceInputs in,
-                                  const LatticeFaceArrays out) {
-    parallel_for(device, "melting_faces", g.count, [=] MW_HD(std::size_t k) {
+// One melting object's exposed vertices: their normals (see the top of the file).
+inline void melting_lattice_normals(const DeviceContext& device, const MeltingGrid g, const LatticeFaceInputs in,
+                                    const LatticeFaceArrays out) {
+    parallel_for(device, "melting_face_normals", g.count, [=] MW_HD(std::size_t k) {
         const std::uint32_t s = g.base + static_cast<std::uint32_t>(k);
         const std::uint32_t i = in.store_of_slot[s];
         Vec3 normal{0, 0, 0};
-        Real inverse_mass = 0;
         if (i != kMeltedSlot && in.type[i] == kSurfaceBoundary) {
             const std::int32_t* c = in.slot_coord + 3 * std::size_t(s);
             const Vec3 xi = in.position[i];
             Vec3 inward{0, 0, 0};
-            for (std::int32_t dz = -1; dz <= 1; ++dz)
-                for (std::int32_t dy = -1; dy <= 1; ++dy)
-                    for (std::int32_t dx = -1; dx <= 1; ++dx) {
-                        if (dx == 0 && dy == 0 && dz == 0) continue;
-                        const std::int64_t cell = g.cell(c[0] + dx, c[1] + dy, c[2] + dz);
-                        if (cell < 0) continue;
-                        const std::int32_t t = in.cell_slot[cell];
-                        if (t < 0) continue;
-                        const std::uint32_t j = in.store_of_slot[t];
-                        if (j != kMeltedSlot) inward += in.position[j] - xi;
-                    }
+            g.for_each_one_ring_cell(c[0], c[1], c[2], [&](std::int64_t cell) {
+                const std::int32_t t = in.cell_slot[cell];
+                if (t < 0) return;
+                const std::uint32_t j = in.store_of_slot[t];
+                if (j != kMeltedSlot) inward += in.position[j] - xi;
+            });
             const Real length = norm(inward);
             if (length > in.sheet_below) normal = (Real(-1) / length) * inward;
-            if (out.inverse_mass && !in.pinned[s]) {
-                const std::uint32_t begin = in.regions_begin[s], end = in.regions_end[s];
-                Real sum = 0;
-                for (std::uint32_t e = begin; e < end; ++e) sum += Real(1) / in.region_mass[in.member_index[e]];
-                const Real regions = Real(end - begin);
-                inverse_mass = end > begin ? sum / (regions * regions) : Real(0);
-            }
         }
         out.normal[s] = normal;
-        if (out.inverse_mass) out.inverse_mass[s] = inverse_mass;
+    });
+}
+
+// One melting object's exposed vertices: their contact masses, two-way (out.inverse_mass not null).
+inline void melting_lattice_contact_masses(const DeviceContext& device, const MeltingGrid g, const LatticeFaceInputs in,
+                                           const LatticeFaceArrays out) {
+    parallel_for(device, "melting_face_masses", g.count, [=] MW_HD(std::size_t k) {
+        const std::uint32_t s = g.base + static_cast<std::uint32_t>(k);
+        const std::uint32_t i = in.store_of_slot[s];
+        Real inverse_mass = 0;
+        if (i != kMeltedSlot && in.type[i] == kSurfaceBoundary && !in.pinned[s]) {
+            const std::uint32_t begin = in.regions_begin[s], end = in.regions_end[s];
+            Real sum = 0;
+            for (std::uint32_t e = begin; e < end; ++e) sum += Real(1) / in.region_mass[in.member_index[e]];
+            const Real regions = Real(end - begin);
+            inverse_mass = end > begin ? sum / (regions * regions) : Real(0);
+        }
+        out.inverse_mass[s] = inverse_mass;
     });
 }
 

@@ -43,6 +43,18 @@ struct MeltingGrid {
         if (i < 0 || j < 0 || k < 0 || i >= dims[0] || j >= dims[1] || k >= dims[2]) return -1;
         return std::int64_t(first_cell) + (std::int64_t(k) * dims[1] + j) * dims[0] + i;
     }
+    // Calls visit(n) for each cell n of (i, j, k)'s one-ring inside the box (not the cell itself),
+    // z slowest and x fastest: the order every sum over a vertex's one-ring takes.
+    template <class Visit>
+    MW_INLINE void for_each_one_ring_cell(std::int32_t i, std::int32_t j, std::int32_t k, Visit&& visit) const {
+        for (std::int32_t dk = -1; dk <= 1; ++dk)
+            for (std::int32_t dj = -1; dj <= 1; ++dj)
+                for (std::int32_t di = -1; di <= 1; ++di) {
+                    if ((di | dj | dk) == 0) continue;
+                    const std::int64_t n = cell(i + di, j + dj, k + dk);
+                    if (n >= 0) visit(n);
+                }
+    }
 };
 
 // The store's side of a phase change: the slot map and the particles' fields it changes.
@@ -90,12 +102,9 @@ inline void melting_reach(const DeviceContext& device, const MeltingGrid g, cons
             const std::int32_t j = std::int32_t((c / std::uint32_t(g.dims[0])) % std::uint32_t(g.dims[1]));
             const std::int32_t k = std::int32_t(c / (std::uint32_t(g.dims[0]) * std::uint32_t(g.dims[1])));
             std::uint8_t best = from[g.first_cell + c];
-            for (std::int32_t dk = -1; dk <= 1; ++dk)
-                for (std::int32_t dj = -1; dj <= 1; ++dj)
-                    for (std::int32_t di = -1; di <= 1; ++di) {
-                        const std::int64_t n = g.cell(i + di, j + dj, k + dk);
-                        if (n >= 0 && from[n] + 1 < best) best = std::uint8_t(from[n] + 1);
-                    }
+            g.for_each_one_ring_cell(i, j, k, [&](std::int64_t n) {
+                if (from[n] + 1 < best) best = std::uint8_t(from[n] + 1);
+            });
             to[g.first_cell + c] = best;
         });
         std::uint8_t* t = from;
@@ -130,15 +139,10 @@ inline void melting_phase_change(const DeviceContext& device, const MeltingGrid 
         const std::uint32_t i = d.particles.store_of_slot[s];
         if (d.particles.type[i] != kInnerBoundary) return;
         int left = 0;
-        for (std::int32_t dk = -1; dk <= 1; ++dk)
-            for (std::int32_t dj = -1; dj <= 1; ++dj)
-                for (std::int32_t di = -1; di <= 1; ++di) {
-                    if ((di | dj | dk) == 0) continue;
-                    const std::int64_t n = g.cell(at[0] + di, at[1] + dj, at[2] + dk);
-                    if (n < 0) continue;
-                    const std::int32_t q = d.cell_slot[n];
-                    left += q >= 0 && d.left(q);
-                }
+        g.for_each_one_ring_cell(at[0], at[1], at[2], [&](std::int64_t n) {
+            const std::int32_t q = d.cell_slot[n];
+            left += q >= 0 && d.left(q);
+        });
         if (left == g.full_ring) return;
         d.particles.type[i] = kSurfaceBoundary;
         d.exposed[s] = 1;
