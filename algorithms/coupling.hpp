@@ -101,7 +101,7 @@ struct CouplingData {
     const Real* sbp_eta = nullptr;
     SbpFaces faces;
     // Inside PCISPH (coupling.strong): only the slots of the objects that answer there (rigid
-    // ones and cloths: LsmObjectParams::answers) are gathered (each slot's object, and the
+    // and solid elastic ones, cloths: LsmObjectParams::answers) are gathered (each slot's object, and the
     // objects' parameters); null: every slot.
     const std::int32_t* slot_object = nullptr;
     const LsmObjectParams* answering_only = nullptr;
@@ -215,9 +215,11 @@ inline void gather_solid_forces(const DeviceContext& device, const CouplingData 
 }
 
 
-// Strong coupling (coupling.strong): rigid objects answer the fluid's pressure inside the PCISPH
-// iterations. Each iteration meets a rigid object where the step takes it under a linear and an
-// angular acceleration (SolidLookahead::object_response); the fluid's reaction at that iteration
+// Strong coupling (coupling.strong): rigid and solid elastic objects (LsmObjectParams::body_answer)
+// answer the fluid's pressure inside the PCISPH iterations, each as one body. Each iteration meets
+// such an object where the step takes it under a linear and an angular acceleration
+// (SolidLookahead::object_response: a rigid object's particles from their own velocities, an
+// elastic one's from its mean velocity); the fluid's reaction at that iteration
 // gives the accelerations it implies, G = (g + F/M, I⁻¹ τ) (F and τ the fluid's force and torque
 // on the object's IBPs about its centre, the coupling's reaction gathered as above; M, I its mass
 // and inertia), and the expected accelerations move toward G. The domain's walls bound G as LSM
@@ -230,14 +232,14 @@ inline void gather_solid_forces(const DeviceContext& device, const CouplingData 
 // ω_k = -ω_{k-1} r_{k-1}·(r_k - r_{k-1}) / |r_k - r_{k-1}|², within [kMinRelaxation, 1], from
 // kFirstRelaxation (the angular part scaled by the object's half-diagonal). Only the answering
 // objects' particles are gathered inside PCISPH (CouplingData::answering_only).
-// Elastic objects are met at their mean velocity, without an answer: measured, the same answer
-// (their mean acceleration) left the heavy elastic cubes at CFL 1 gaining energy or running away
-// at the floor in ways that changed with any detail of the relaxation (docs/coupling.md).
+// An elastic object's answer sees its motion as a body, not its deformation, which its
+// whole-body damping (lsm.body_damping, 5/s by default) keeps down: without it the answer stirred
+// the heavy elastic cubes at CFL 1 into gaining energy (docs/coupling.md).
 struct ObjectIbps {
     const std::uint32_t* begin = nullptr;  // per object, its first IBP slot (and one past the last)
     const std::uint32_t* store_of_slot = nullptr;
     const Real* mass = nullptr;  // per IBP slot
-    const LsmObjectParams* params = nullptr;  // per object (rigid or not, its wall margin)
+    const LsmObjectParams* params = nullptr;  // per object (whether it answers as one body, its wall margin)
     std::size_t count = 0;
 };
 struct ResponseRelaxation {
@@ -287,7 +289,7 @@ inline void relax_object_accelerations(const DeviceContext& device, ObjectIbps o
     parallel_for(device, "strong_coupling_relax", objects.count, [=] MW_HD(std::size_t o) {
         const ObjectResponse now = response[o];
         const LsmObjectParams params = objects.params[o];
-        if (!params.rigid) {
+        if (!params.body_answer) {
             next[o] = now;
             return;
         }

@@ -14,11 +14,13 @@ struct CouplingParams {
     Real slip = 1;  // the correction's tangential rule: 1 free slip, 0 no slip
     // PCISPH meets the moving solids' boundary particles where they will be at the end of the step.
     bool predict_solids = true;
-    // Rigid objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids):
-    // each iteration meets them where gravity and the last iterations' pressure take them.
+    // Rigid and solid elastic objects answer the fluid's pressure inside the PCISPH iterations,
+    // each as one body (with predict_solids): each iteration meets them where gravity and the last
+    // iterations' pressure take them.
     bool strong = true;
-    // Rigid objects' surface particles sit inside their mesh's face by the walls' gap
-    // (sampling/surface_inset.hpp), so that the fluid rests at the face as it does at a wall.
+    // Rigid and elastic objects' surface particles sit inside their mesh's face by the walls' gap
+    // (sampling/surface_inset.hpp), so that the fluid rests at the face as it does at a wall; a
+    // thin elastic object's stay on its faces (apps/scene_builder.cpp).
     bool surface_inset = true;
 };
 
@@ -35,9 +37,9 @@ inline const ParamTable<CouplingParams>& coupling_keys() {
         t.push_back(boolean_key<T>("coupling", "predict_solids", member(&T::predict_solids),
                                    "PCISPH meets the objects where the step will take them, not where they start it"));
         t.push_back(boolean_key<T>("coupling", "strong", member(&T::strong),
-                                   "rigid objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids)"));
+                                   "rigid and elastic objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids)"));
         t.push_back(boolean_key<T>("coupling", "surface_inset", member(&T::surface_inset),
-                                   "rigid objects' surface particles sit inside the face by the walls' gap, so fluid rests at the face"));
+                                   "rigid and elastic objects' surface particles sit inside the face by the walls' gap, so fluid rests at the face"));
         return t;
     }();
     return table;

@@ -56,7 +56,11 @@ struct LsmObjectParams {
     // (coupling.strong; coupling.hpp, relax_node_accelerations), and PCISPH meets each of its
     // particles at its own velocity.
     std::uint8_t nodal = 0;
-    MW_HD bool answers() const { return rigid || nodal; }  // inside PCISPH, under coupling.strong
+    // 1 for a rigid object and a solid elastic one (not melting): it answers the fluid's pressure
+    // inside PCISPH as one body, by a linear and an angular acceleration (coupling.strong;
+    // coupling.hpp, relax_object_accelerations).
+    std::uint8_t body_answer = 0;
+    MW_HD bool answers() const { return body_answer || nodal; }  // inside PCISPH, under coupling.strong
 };
 
 struct SbpLink {
@@ -492,6 +496,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         P.margin = Real(0.5) * s.spacing;
         P.rigid = s.kind == SolidKind::kRigid ? 1 : 0;
         P.nodal = is_thin(s.kind) ? 1 : 0;
+        P.body_answer = s.kind == SolidKind::kRigid || (s.kind == SolidKind::kElastic && !s.melts()) ? 1 : 0;
         const Real mass = s.density * s.spacing * s.spacing * s.spacing;
         const std::size_t base = ibp_base[o];
         for (std::size_t k = 0; k < s.ibp.size(); ++k) {

@@ -103,8 +103,8 @@ inline void predict_positions(const DeviceContext& device, std::size_t fluid_cou
     });
 }
 
-// A rigid object's expected acceleration in the step: linear, and angular about its centre
-// (coupling.hpp, relax_object_accelerations).
+// A rigid or solid elastic object's expected acceleration in the step: linear, and angular about
+// its centre (coupling.hpp, relax_object_accelerations).
 struct ObjectResponse {
     Vec3 linear{0, 0, 0}, angular{0, 0, 0}, centre{0, 0, 0};
 };
@@ -119,7 +119,7 @@ struct ObjectResponse {
 // accelerations the solve expects (coupling.strong); a soft object's at its object's mean
 // velocity, since its own carries the object's vibration, which the fluid's pressure would answer
 // (the floating jelly's pool ran three times as fast; docs/coupling.md, "Solids met where they
-// will be"). A cloth's particles are taken ahead each at its own velocity, changed by the
+// will be"), changed likewise for a solid elastic one (not a melting one). A cloth's particles are taken ahead each at its own velocity, changed by the
 // acceleration the solve expects of it (coupling.strong). Static boundary particles stay put.
 struct SolidLookahead {
     const Vec3* velocity = nullptr;            // the store's; null: every boundary particle where it is
@@ -127,8 +127,9 @@ struct SolidLookahead {
     const LsmObjectParams* objects = nullptr;     // per object: whether it is rigid
     const std::int32_t* solid_slot = nullptr;     // the store's solid_slot field (solid_bodies.hpp)
     const std::int32_t* slot_object = nullptr;    // per IBP and SBP slot, its object
-    // Per object, the accelerations the solve expects the step to give a rigid object (gravity and
-    // the fluid's pressure, coupling.strong; coupling.hpp); null: none, it keeps its velocity.
+    // Per object, the accelerations the solve expects the step to give an object answering as one
+    // body (gravity and the fluid's pressure, coupling.strong; coupling.hpp); null: none, it keeps
+    // its velocity.
     const ObjectResponse* object_response = nullptr;
     // Per IBP and SBP slot, the acceleration the solve expects the step to give a cloth's particle
     // (coupling.strong; coupling.hpp, relax_node_accelerations); null: none, it keeps its velocity.
@@ -153,7 +154,12 @@ struct SolidLookahead {
             }
             return xb + dt * v;
         }
-        return xb + dt * object_velocity[o];
+        Vec3 v = object_velocity[o];
+        if (object_response && objects[o].body_answer) {
+            const ObjectResponse r = object_response[o];
+            v += dt * (r.linear + cross(r.angular, xb - r.centre));
+        }
+        return xb + dt * v;
     }
 };
 

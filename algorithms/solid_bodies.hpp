@@ -106,13 +106,12 @@ class SolidBodies final : public Module {
             region_omega_.assign(regions, Vec3{0, 0, 0});
         }
         objects_.upload(L.objects);
-        has_rigid_ = false;
-        has_elastic_ = false;
+        has_rigid_ = has_body_answer_ = has_elastic_ = has_cloth_ = false;
         bool body_damping = false;
-        has_cloth_ = false;
         for (const auto& o : L.objects) {
             has_cloth_ = has_cloth_ || o.nodal;
             has_rigid_ = has_rigid_ || o.rigid;
+            has_body_answer_ = has_body_answer_ || o.body_answer;
             has_elastic_ = has_elastic_ || !o.rigid;
             body_damping = body_damping || o.body_damping_rate > Real(0);
         }
@@ -259,6 +258,8 @@ class SolidBodies final : public Module {
 
     bool active() const { return ibp_count_ > 0; }
     bool has_rigid() const { return has_rigid_; }
+    // Any object that answers inside PCISPH as one body (LsmObjectParams::body_answer).
+    bool has_body_answer() const { return has_body_answer_; }
     Vec3 domain_min() const { return domain_min_; }
     Vec3 domain_max() const { return domain_max_; }
     // Whether the fluid's forces reach the solids (coupling.hpp): two-way coupling on, and fluid.
@@ -719,6 +720,7 @@ class SolidBodies final : public Module {
     bool has_rigid_ = false;  // any rigid object (lsm_rigid_walls)
     bool has_cloth_ = false;  // any cloth (its nodes answer inside PCISPH)
     bool has_elastic_ = false;  // any elastic object (substeps())
+    bool has_body_answer_ = false;  // any object answering inside PCISPH as one body
     Real substep_ = 0;          // solver.solid_substep
     DeviceArray<Vec3> wall_impulse_;  // per IBP of a rigid object, its walls' impulses this step
     DeviceArray<BodyMotion> body_motion_;  // per object, with lsm.body_damping: its rigid motion this step

@@ -24,7 +24,7 @@ struct SolidParams {
     int region_half_width = 2;  // w: a region holds the IBPs within w lattice links (elastic)
     Real stiffness = 1;         // alpha in (0, 1]
     Real damping = 0;           // 1/s: rate at which non-rigid velocity in each region decays
-    Real body_damping = 0;      // 1/s: rate at which velocity apart from the whole body's rigid motion decays
+    Real body_damping = 5;      // 1/s: rate at which velocity apart from the whole body's rigid motion decays
     Real wall_friction = 0.2;   // [0, 1]: share of tangential velocity removed per wall contact
     Real interface_tension = 0;  // eta of Eq. 9 between its SBPs and the fluid, m4 kg-1 s-2 (interface_tension.hpp)
     Real thermal_diffusivity = Real(1.43e-7);  // alpha, m2/s, with heat conduction (heat.hpp)

@@ -21,7 +21,7 @@ inline constexpr StageInfo kStepStages[] = {
      "a moving solid; the melting lattices' faces"},
     {"solid_volumes", "boundary_volumes, solids, coupling", "fluid and moving solids",
      "Akinci volumes of the moving solids' boundary particles; where the solids will be at the step's end; the rigid "
-     "objects' answer inside PCISPH (coupling.strong)"},
+     "and elastic objects' answer inside PCISPH (coupling.strong)"},
     {"viscosity", "fluid", "fluid with viscosity or wall friction",
      "gravity, viscosity (Eq. 4, mirrored across the domain walls) and wall friction (Eq. 8)"},
     {"interface_tension", "interface_tension", "fluid and an object with interface tension",

@@ -1,7 +1,8 @@
 // The two-way coupling module (stage "coupling", with fluid, moving solids and
 // coupling.two_way): every force the fluid felt from a moving solid's boundary particles in this
 // step's PCISPH goes back to the solid's inner particles (coupling.hpp), which LSM then moves.
-// With coupling.strong (and predict_solids) rigid objects also answer the pressure inside PCISPH:
+// With coupling.strong (and predict_solids) rigid and solid elastic objects also answer the
+// pressure inside PCISPH, each as one body:
 // before each iteration the last one's reaction moves each object's expected acceleration
 // (coupling.hpp, relax_object_accelerations), and the iteration meets the object there; a cloth's
 // nodes answer one by one (relax_node_accelerations).
@@ -22,7 +23,7 @@ class TwoWayCoupling final : public Module, public PressureResponse {
                    SolidBodies& solids, bool lists)
         : state_(state), volumes_(volumes), fluid_(fluid), solids_(solids), lists_(lists),
           active_(state.has_fluid && solids.active() && solids.coupled()),
-          strong_(active_ && (solids.has_rigid() || solids.has_cloth()) && state.params.coupling.strong &&
+          strong_(active_ && (solids.has_body_answer() || solids.has_cloth()) && state.params.coupling.strong &&
                   state.params.coupling.predict_solids),
           nodal_(strong_ && solids.has_cloth()) {
         if (active_ && lists_) {

@@ -271,20 +271,21 @@ void print_coupling(const InfoFacts& f) {
         std::printf("coupling    one-way (coupling.two_way false): %ld moving object(s) push the fluid and feel none "
                     "of it\n",
                     f.moving_objects);
-    const bool rigid = std::any_of(scene.objects.begin(), scene.objects.end(),
-                                   [](const SceneObject& o) { return o.kind == SolidKind::kRigid; });
-    // Rigid objects' surface particles set in (sampling/surface_inset.hpp; an open mesh's are not);
+    const bool solid_kind = std::any_of(scene.objects.begin(), scene.objects.end(), [](const SceneObject& o) {
+        return o.kind == SolidKind::kRigid || (o.kind == SolidKind::kElastic && !o.melts());
+    });
+    // Rigid and elastic objects' surface particles set in (sampling/surface_inset.hpp; an open mesh's are not);
     // the correction's band follows (algorithms/wall_contact.hpp, moving_solid_contact).
     const bool set_in = f.setup.any_sbp_set_in();
     if (set_in) {
         const FluidParams& fp = scene.params.fluid;
         const double inset = rest_density_wall_gap(fp.spacing, fp.support_radius, fp.spacing / 2, 1, fp.kernel);
-        std::printf("            rigid ones' surface particles sit %.2f r0 inside their faces, where the fluid rests as "
+        std::printf("            rigid and elastic ones' surface particles sit %.2f r0 inside their faces, where the fluid rests as "
                     "at a wall (coupling.surface_inset)\n",
                     inset / double(fp.spacing));
     }
-    else if (rigid)
-        std::printf("            rigid ones' surface particles sit on their faces (%s): the fluid rests about one r0 "
+    else if (solid_kind)
+        std::printf("            rigid and elastic ones' surface particles sit on their faces (%s): the fluid rests about one r0 "
                     "off them\n",
                     c.surface_inset ? "their meshes are open: no inside to set them into" : "coupling.surface_inset false");
     if (c.correction)
@@ -299,13 +300,13 @@ void print_coupling(const InfoFacts& f) {
                     "rigid ones, cloths and rods at their particles' velocity, soft ones at their mean velocity\n");
         const bool cloth = std::any_of(scene.objects.begin(), scene.objects.end(),
                                        [](const SceneObject& o) { return is_thin(o.kind); });
-        const char* answering = rigid && cloth ? "rigid ones and the cloths' and rods' nodes"
-                                : rigid        ? "rigid ones"
-                                               : "the cloths' and rods' nodes";
-        if ((rigid || cloth) && c.two_way && c.strong)
+        const char* answering = solid_kind && cloth ? "rigid and solid elastic ones (each as one body) and the cloths' and rods' nodes"
+                                : solid_kind        ? "rigid and solid elastic ones, each as one body,"
+                                                    : "the cloths' and rods' nodes";
+        if ((solid_kind || cloth) && c.two_way && c.strong)
             std::printf("            %s answer the fluid's pressure inside every PCISPH iteration (coupling.strong)\n",
                         answering);
-        else if ((rigid || cloth) && c.two_way)
+        else if ((solid_kind || cloth) && c.two_way)
             std::printf("            %s feel the fluid's pressure only after PCISPH (coupling.strong false): it is "
                         "solved as if they kept their velocity\n",
                         answering);

@@ -654,8 +654,8 @@ int main(int argc, char** argv) {
             const double end_time = o.quick ? 0.6 : 1.5;
             std::string rows;
             long fluid = 0;
-            // Rigid cubes with and without coupling.strong side by side (it answers for rigid
-            // objects only; an elastic cube runs the same either way).
+            // Rigid cubes with and without coupling.strong side by side; the elastic cubes with it
+            // (their defaults: docs/coupling.md, "An elastic object answers as one body").
             struct ExtremeKind {
                 const char* kind;
                 const char* strong;

@@ -28,6 +28,8 @@ inline SimulationSetup empty_setup(Vec3 lo, Vec3 hi, Real dt, Vec3 gravity, Real
     return s;
 }
 
+// A solid for the shape matching's own tests: undamped (no region damping unless `damping`, and
+// no whole-body damping, whose default is 5/s) unless a test sets it.
 inline SolidSetup solid(SolidKind kind, Real density = 1000, int w = 2, Real alpha = 1, Real damping = 0) {
     SolidSetup s;
     s.name = "body";
@@ -36,6 +38,7 @@ inline SolidSetup solid(SolidKind kind, Real density = 1000, int w = 2, Real alp
     s.region_half_width = w;
     s.stiffness = alpha;
     s.damping = damping;
+    s.body_damping = 0;
     return s;
 }
 

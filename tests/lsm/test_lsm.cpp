@@ -168,19 +168,23 @@ TEST_CASE("a body at rest with no forces stays at rest for 1000 steps") {
     CHECK(drift < 1e-5 * r0);
 }
 
-TEST_CASE("a rigid object's surface particles sit inside its faces, and a bad inset is refused") {
+TEST_CASE("a rigid or thick elastic object's surface particles sit inside its faces, and a bad inset is refused") {
     SimulationSetup s = empty_setup(Vec3{0, 0, 0}, Vec3{1, 1, 1}, Real(0.002), Vec3{0, 0, 0});
     add(s, box_mesh(Vec3{0.2f, 0.2f, 0.2f}, Vec3{0.5f, 0.5f, 0.5f}), solid(SolidKind::kRigid));
     add(s, box_mesh(Vec3{0.2f, 0.2f, 0.2f}, Vec3{0.2f, 0.2f, 0.2f}), solid(SolidKind::kElastic));
+    add(s, box_mesh(Vec3{0.2f, 0.2f, 0.006f}, Vec3{0.2f, 0.7f, 0.5f}), solid(SolidKind::kElastic));
     const Real r0 = s.params.fluid.spacing;
-    // The rigid box's SBPs the walls' gap (0.6 r0 at h = 2 r0) inside its faces, the elastic box's
-    // on them (coupling.surface_inset).
-    const SolidSetup &rigid = s.solids[0], &elastic = s.solids[1];
+    // The rigid box's and the thick elastic box's SBPs the walls' gap (0.6 r0 at h = 2 r0) inside
+    // their faces, the elastic plate's (3 r0 thick, under twice h) on them (coupling.surface_inset).
+    const SolidSetup &rigid = s.solids[0], &elastic = s.solids[1], &plate = s.solids[2];
     REQUIRE(rigid.sbp_inset.size() == rigid.sbp.size());
+    REQUIRE(elastic.sbp_inset.size() == elastic.sbp.size());
+    REQUIRE(plate.sbp_inset.size() == plate.sbp.size());
     for (const Real inset : rigid.sbp_inset) CHECK(inset == doctest::Approx(0.6 * r0).epsilon(0.05));
-    for (const Real inset : elastic.sbp_inset) CHECK(inset == 0);
+    for (const Real inset : elastic.sbp_inset) CHECK(inset == doctest::Approx(0.6 * r0).epsilon(0.05));
+    for (const Real inset : plate.sbp_inset) CHECK(inset == 0);
     const LsmHostLayout layout = build_lsm_layout(s);
-    REQUIRE(layout.sbp.size() == rigid.sbp.size() + elastic.sbp.size());
+    REQUIRE(layout.sbp.size() == rigid.sbp.size() + elastic.sbp.size() + plate.sbp.size());
     for (std::size_t k = 0; k < rigid.sbp.size(); ++k) CHECK(layout.sbp[k].inset == rigid.sbp_inset[k]);
     SimulationSetup wrong_length = s;
     wrong_length.solids[0].sbp_inset.pop_back();
