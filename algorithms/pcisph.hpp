@@ -119,12 +119,13 @@ struct ObjectResponse {
 // accelerations the solve expects (coupling.strong); a soft object's at its object's mean
 // velocity, since its own carries the object's vibration, which the fluid's pressure would answer
 // (the floating jelly's pool ran three times as fast; docs/coupling.md, "Solids met where they
-// will be"), changed likewise for a solid elastic one (not a melting one). A cloth's particles are taken ahead each at its own velocity, changed by the
-// acceleration the solve expects of it (coupling.strong). Static boundary particles stay put.
+// will be"), changed likewise for a solid elastic one (not a melting one). A cloth's particles are
+// taken ahead each at its own velocity, changed by the acceleration the solve expects of it
+// (coupling.strong). Static boundary particles stay put.
 struct SolidLookahead {
     const Vec3* velocity = nullptr;            // the store's; null: every boundary particle where it is
     const Vec3* object_velocity = nullptr;        // per object, its mean velocity
-    const LsmObjectParams* objects = nullptr;     // per object: whether it is rigid
+    const LsmObjectParams* objects = nullptr;     // per object: rigid, nodal, answering as one body
     const std::int32_t* solid_slot = nullptr;     // the store's solid_slot field (solid_bodies.hpp)
     const std::int32_t* slot_object = nullptr;    // per IBP and SBP slot, its object
     // Per object, the accelerations the solve expects the step to give an object answering as one
@@ -146,15 +147,8 @@ struct SolidLookahead {
             if (slot_acceleration) v += dt * slot_acceleration[slot];
             return xb + dt * v;
         }
-        if (objects[o].rigid) {
-            Vec3 v = velocity[b];
-            if (object_response) {
-                const ObjectResponse r = object_response[o];
-                v += dt * (r.linear + cross(r.angular, xb - r.centre));
-            }
-            return xb + dt * v;
-        }
-        Vec3 v = object_velocity[o];
+        // A rigid object's particle at its own velocity, a soft object's at the object's mean.
+        Vec3 v = objects[o].rigid ? velocity[b] : object_velocity[o];
         if (object_response && objects[o].body_answer) {
             const ObjectResponse r = object_response[o];
             v += dt * (r.linear + cross(r.angular, xb - r.centre));

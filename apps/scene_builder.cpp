@@ -529,14 +529,15 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
         const double layer_spacing = outline ? surface_spacing * r0 : r0 / 2;
         const double depth = rest_density_wall_gap(Real(r0), Real(h), Real(layer_spacing), 1, setup.params.fluid.kernel,
                                                    setup.params.dimensions);
-        inset = outline ? outline_insets(sample.geometry, sample.sbp, depth)
-                        : surface_insets(sample.geometry, sample.sbp, depth);
-        if (solid.kind == SolidKind::kElastic) {
-            const std::vector<double> half_thickness = outline ? outline_insets(sample.geometry, sample.sbp, h)
-                                                               : surface_insets(sample.geometry, sample.sbp, h);
-            if (std::any_of(half_thickness.begin(), half_thickness.end(), [&](double d) { return d < h; }))
-                std::fill(inset.begin(), inset.end(), 0.0);
-        }
+        // One ray per SBP: its half thickness up to `probe` (h for an elastic object, to find the
+        // thin ones; depth, never more than h, sets the inset).
+        const double probe = solid.kind == SolidKind::kElastic ? std::max(h, depth) : depth;
+        const std::vector<double> half_thickness = outline ? outline_insets(sample.geometry, sample.sbp, probe)
+                                                           : surface_insets(sample.geometry, sample.sbp, probe);
+        const bool thin_elastic = solid.kind == SolidKind::kElastic &&
+                                  std::any_of(half_thickness.begin(), half_thickness.end(), [&](double d) { return d < h; });
+        if (!thin_elastic)
+            for (std::size_t k = 0; k < inset.size(); ++k) inset[k] = std::min(depth, half_thickness[k]);
     }
     // Where each step puts them (solid_face.hpp: faded near the domain walls).
     const BoundaryParams& walls = setup.params.boundary;
