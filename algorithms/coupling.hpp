@@ -166,36 +166,42 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
             d.reaction[s] = Vec3{0, 0, 0};
             return;
         }
-        const Vec3 xb = position[b], vb = velocity[b];
-        const Real eta = d.sbp_eta && s >= d.ibp_count ? d.sbp_eta[s - d.ibp_count] : Real(0);
-        Vec3 pressure_sum{0, 0, 0}, friction_sum{0, 0, 0}, tension_sum{0, 0, 0};
-        const Vec3 xb_met = pairs.lookahead.place(b, xb);
-        const Vec3 xb_face = eta > Real(0) ? d.faces.at(xb, static_cast<std::uint32_t>(s - d.ibp_count)) : xb;
-        const Real h2 = c.kernel.h * c.kernel.h;
-        const auto add = [&](std::uint32_t i, Real paired) {
-            const Vec3 xi = position[i];
-            const Vec3 r = predicted[i] - xb_met;
-            pressure_sum += (paired * pressure_term[i]) * c.kernel.grad_W_r2(r, norm2(r));
-            if (friction) friction_sum += c.kernel.laplacian_visc_r2(norm2(xi - xb)) * (vb - velocity[i]);
-            if (eta > Real(0) && norm2(xi - xb) < h2) {
-                const Vec3 x_is = xi - xb_face;
-                const Real r2 = norm2(x_is);
-                const Real w = c.kernel.W_r2(r2);
-                if (w > Real(0) && r2 > Real(0)) tension_sum += (w / std::sqrt(r2)) * x_is;
-            }
-        };
         const std::uint32_t listed = pairs.rows ? pairs.row_count[s] : kRowOverflow;
-        if (listed != kRowOverflow) {
-            const std::uint32_t* row = pairs.rows + s * pairs.row_capacity;
-            for (std::uint32_t k = 0; k < listed; ++k) add(row[k], Real(1));
-        } else {
-            pairs.grid.for_each_fluid(xb, [&](std::uint32_t i) {
-                add(i, lists ? (norm2(position[i] - xb) < pairs.list_radius2 ? Real(1) : Real(0)) : Real(1));
-            });
+        Vec3 reaction{0, 0, 0};
+        // A slot with no fluid pair (most of a large object's, and all its inner ones) takes only
+        // the correction's impulses.
+        if (listed != 0) {
+            const Vec3 xb = position[b], vb = velocity[b];
+            const Real eta = d.sbp_eta && s >= d.ibp_count ? d.sbp_eta[s - d.ibp_count] : Real(0);
+            Vec3 pressure_sum{0, 0, 0}, friction_sum{0, 0, 0}, tension_sum{0, 0, 0};
+            // Where this iteration's sums met b (its placement is kept for them; pcisph.hpp).
+            const Vec3 xb_met = pairs.lookahead.met_position(b, position);
+            const Vec3 xb_face = eta > Real(0) ? d.faces.at(xb, static_cast<std::uint32_t>(s - d.ibp_count)) : xb;
+            const Real h2 = c.kernel.h * c.kernel.h;
+            const auto add = [&](std::uint32_t i, Real paired) {
+                const Vec3 xi = position[i];
+                const Vec3 r = predicted[i] - xb_met;
+                pressure_sum += (paired * pressure_term[i]) * c.kernel.grad_W_r2(r, norm2(r));
+                if (friction) friction_sum += c.kernel.laplacian_visc_r2(norm2(xi - xb)) * (vb - velocity[i]);
+                if (eta > Real(0) && norm2(xi - xb) < h2) {
+                    const Vec3 x_is = xi - xb_face;
+                    const Real r2 = norm2(x_is);
+                    const Real w = c.kernel.W_r2(r2);
+                    if (w > Real(0) && r2 > Real(0)) tension_sum += (w / std::sqrt(r2)) * x_is;
+                }
+            };
+            if (listed != kRowOverflow) {
+                const std::uint32_t* row = pairs.rows + s * pairs.row_capacity;
+                for (std::uint32_t k = 0; k < listed; ++k) add(row[k], Real(1));
+            } else {
+                pairs.grid.for_each_fluid(xb, [&](std::uint32_t i) {
+                    add(i, lists ? (norm2(position[i] - xb) < pairs.list_radius2 ? Real(1) : Real(0)) : Real(1));
+                });
+            }
+            const Real vb_volume = boundary_volume[b];
+            reaction = (pressure_scale * vb_volume) * pressure_sum + (friction_scale * vb_volume) * friction_sum +
+                       (pressure_scale * vb_volume * eta) * tension_sum;
         }
-        const Real vb_volume = boundary_volume[b];
-        Vec3 reaction = (pressure_scale * vb_volume) * pressure_sum + (friction_scale * vb_volume) * friction_sum +
-                        (pressure_scale * vb_volume * eta) * tension_sum;
         if (d.sbp_contact_impulse && s >= d.ibp_count)
             reaction += d.inverse_dt * d.sbp_contact_impulse[s - d.ibp_count];
         if (d.lattice_contact_impulse && s < d.ibp_count) reaction += d.inverse_dt * d.lattice_contact_impulse[s];

@@ -28,6 +28,7 @@ class Fluid final : public Module {
         pressure_term_.resize(moving);
         predicted_.resize(moving);
         if (has_viscosity_ || tension) nonpressure_.resize(moving);
+        if (volumes.moving_solids()) solid_met_.resize(moving);
     }
 
     void bind(StepPlan& plan) override {
@@ -121,7 +122,8 @@ class Fluid final : public Module {
     // corrected state there before applying it.
     View<Vec3> scratch_after_integration(int which) { return which == 0 ? predicted_.view() : pressure_acc_.view(); }
     std::size_t bytes() const override {
-        return nonpressure_.bytes() + pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes();
+        return nonpressure_.bytes() + pressure_acc_.bytes() + pressure_term_.bytes() + predicted_.bytes() +
+               solid_met_.bytes();
     }
 
    private:
@@ -148,6 +150,10 @@ class Fluid final : public Module {
             // The first prediction has no pressure acceleration yet (nothing to clear beforehand).
             const bool first = iterations == 0;
             if (step.pressure_response) step.pressure_response->before_iteration(step, dt, iterations);
+            if (step.lookahead.velocity && !solid_met_.empty()) {
+                place_moving_solids(device, step.lookahead, store.position.cview(), solid_met_.view().data());
+                step.lookahead.met = solid_met_.view().data();
+            }
             predict_positions(device, fluid_count, store.position.cview(), store.velocity.cview(), step.nonpressure,
                               first ? nullptr : pressure_acc_.view().data(), predicted_.view(), fluid.gravity, dt,
                               walls_.walls(), step.solid_surface);
@@ -190,6 +196,7 @@ class Fluid final : public Module {
     DeviceArray<Vec3> pressure_acc_;  // this iteration's pressure acceleration
     DeviceArray<Real> pressure_term_; // p / rho^2 of this iteration
     DeviceArray<Vec3> predicted_;     // this iteration's predicted positions
+    DeviceArray<Vec3> solid_met_;     // where this iteration meets the moving solids' boundary particles (pcisph.hpp)
 };
 
 MW_BACKEND_END

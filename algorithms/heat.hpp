@@ -43,6 +43,7 @@
 #include <cstdint>
 
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "algorithms/boundary_volumes.hpp"
@@ -131,11 +132,18 @@ template <class Neighbors, class Kernel>
 void heat_substep(const DeviceContext& device, const Neighbors& neighbors, std::size_t first, std::size_t count, std::size_t end,
                   View<const Vec3> position, View<const HeatParticle> particle, View<const Real> in, View<Real> out,
                   Real dt_times_scale, Kernel kernel) {
+    // The grid offers every particle of the cells around, five in six of them farther than h in
+    // 3D: testing the distance first skips their loads (walked on the grid without the test, a
+    // solid's particles took twice the fluid's time on OpenMP). The lists hold pairs within h
+    // already, whose sums stay branch-free.
+    constexpr bool test_range = std::is_same<Neighbors, GridView>::value;
+    const Real h2 = kernel.h * kernel.h;
     parallel_for(device, "heat_substep", count, [=] MW_HD(std::size_t k) {
         const std::size_t i = first + k;
         const Vec3 xi = position[i];
         const Real k_i = particle[i].conductivity, gamma_i = particle[i].deficiency;
         const HeatSums sums = sum_conducting(neighbors, i, xi, [&](std::uint32_t j) {
+            if (test_range && !(norm2(xi - position[j]) < h2)) return HeatSums{};
             std::uint32_t read = 0;
             const Real c = heat_pair(xi, k_i, gamma_i, j, end, position, particle, kernel, read);
             return HeatSums{c, c * in[read]};

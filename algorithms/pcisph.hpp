@@ -135,8 +135,12 @@ struct SolidLookahead {
     // Per IBP and SBP slot, the acceleration the solve expects the step to give a cloth's particle
     // (coupling.strong; coupling.hpp, relax_node_accelerations); null: none, it keeps its velocity.
     const Vec3* slot_acceleration = nullptr;
-    std::size_t end = 0;                       // the moving solids' boundary particles end here
+    std::size_t begin = 0, end = 0;            // the moving solids' boundary particles: [begin, end)
     Real dt = 0;
+    // Where this iteration meets each of them, by b - begin (place_moving_solids), so that the
+    // fluid's sums read one position per pair instead of placing the particle again for every
+    // fluid neighbour; null: placed per pair.
+    const Vec3* met = nullptr;
     MW_INLINE Vec3 place(std::uint32_t b, Vec3 xb) const {
         if (!velocity || b >= end) return xb;
         const std::int32_t slot = solid_slot[b];
@@ -155,7 +159,21 @@ struct SolidLookahead {
         }
         return xb + dt * v;
     }
+    // Boundary particle b where the fluid's sums meet it: the iteration's placement, or where it is.
+    MW_INLINE Vec3 met_position(std::uint32_t b, View<const Vec3> position) const {
+        if (met && b >= begin && b < end) return met[b - begin];
+        return place(b, position[b]);
+    }
 };
+
+// Each moving solid's boundary particle where this iteration meets it (SolidLookahead::met).
+inline void place_moving_solids(const DeviceContext& device, SolidLookahead lookahead, View<const Vec3> position, Vec3* met) {
+    const std::size_t begin = lookahead.begin;
+    parallel_for(device, "pcisph_place_solids", lookahead.end - begin, [=] MW_HD(std::size_t k) {
+        const auto b = static_cast<std::uint32_t>(begin + k);
+        met[k] = lookahead.place(b, position[b]);
+    });
+}
 
 // Predicted density from fluid (at predicted positions) and boundary particles, then
 // p_i += δ (ρ*_i - ρ0), clamped at 0 (free-surface particle deficiency), and p_i/ρ_i².
@@ -173,7 +191,7 @@ void predict_density_and_pressure(const DeviceContext& device, Neighbors neighbo
             return c.kernel.W_r2(norm2(xi - predicted[j]));
         });
         const Real boundary_sum = neighbors.sum_boundary(i, position[i], [&](std::uint32_t b) {
-            return boundary_volume[b] * c.kernel.W_r2(norm2(xi - lookahead.place(b, position[b])));
+            return boundary_volume[b] * c.kernel.W_r2(norm2(xi - lookahead.met_position(b, position)));
         });
         const Real rho = c.mass * fluid_sum + c.rest_density * boundary_sum;
         density[i] = rho;
@@ -208,7 +226,7 @@ void pressure_acceleration(const DeviceContext& device, Neighbors neighbors, std
             return (pi_rho2 + pressure_term[j]) * c.kernel.grad_W_r2(d, norm2(d));
         });
         const Vec3 boundary_sum = neighbors.sum_boundary(i, position[i], [&](std::uint32_t b) {
-            const Vec3 d = xi - lookahead.place(b, position[b]);
+            const Vec3 d = xi - lookahead.met_position(b, position);
             return boundary_volume[b] * c.kernel.grad_W_r2(d, norm2(d));
         });
         pressure_acc[i] = -(c.mass * fluid_sum + (c.rest_density * pi_rho2) * boundary_sum);

@@ -288,7 +288,7 @@ class SolidBodies final : public Module {
     void bind(StepPlan& plan) override {
         if (!active()) return;
         if (predicts_)
-            plan.bind("solid_volumes", [this](StepContext& step) { step.lookahead = lookahead(*store_, step.ranges.solid_end); });
+            plan.bind("solid_volumes", [this](StepContext& step) { step.lookahead = lookahead(*store_, step.ranges); });
         plan.bind("lsm", [this](StepContext& step) {
             step.solid_motion = this->step(*store_, step.dt, gravity_, domain_min_, domain_max_, step.neighbors.grid);
         });
@@ -380,7 +380,7 @@ class SolidBodies final : public Module {
     // object's mean velocity (its momentum over its mass), and the way from a store index to its
     // object. The slot map must
     // be current.
-    SolidLookahead lookahead(const ParticleStore& store, std::size_t solid_end) {
+    SolidLookahead lookahead(const ParticleStore& store, const GroupRanges& ranges) {
         const Vec3* velocity = store.velocity.cview().data();
         Vec3* mean = object_velocity_.view().data();
         object_mass_means(velocity, mean, "solid_object_velocity");
@@ -390,7 +390,8 @@ class SolidBodies final : public Module {
         l.objects = objects_.view().data();
         l.solid_slot = solid_slot_->cview().data();
         l.slot_object = object_.view().data();
-        l.end = solid_end;
+        l.begin = ranges.fluid_end;
+        l.end = ranges.solid_end;
         return l;
     }
 
