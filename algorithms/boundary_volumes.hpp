@@ -10,12 +10,32 @@
 // 8% over-dense per face (16% between two lattices), enough to spray each newly melted particle
 // out of the gap it melted in (tests/core/test_stefan.cpp).
 #pragma once
+#include <limits>
 #include <vector>
 
 #include "algorithms/module.hpp"
 #include "simulation/simulation.hpp"
 
 MW_BACKEND_BEGIN
+
+// Whether a fluid particle in the cells around x lies closer than sqrt(reach2): stops at the first.
+MW_INLINE bool fluid_within(const GridView& grid, View<const Vec3> position, Vec3 x, Real reach2) {
+    int c[3];
+    grid.shape.clamped_cell_of(x, c);
+    const int r = grid.shape.reach;
+    for (int dz = -r; dz <= r; ++dz)
+        for (int dy = -r; dy <= r; ++dy)
+            for (int dx = -r; dx <= r; ++dx) {
+                const int cc[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
+                if (cc[0] < 0 || cc[1] < 0 || cc[2] < 0 || cc[0] >= grid.shape.dims[0] || cc[1] >= grid.shape.dims[1] ||
+                    cc[2] >= grid.shape.dims[2])
+                    continue;
+                const std::uint32_t cell = grid.shape.linear(cc);
+                for (std::uint32_t i = grid.begin[cell], e = grid.end[cell]; i < e; ++i)
+                    if (norm2(position[i] - x) < reach2) return true;
+            }
+    return false;
+}
 
 // Akinci boundary volume V_b = 1 / Σ_k W(x_b - x_k) over boundary neighbours k (b included), for
 // particles [first, first + count). Static particles see static neighbours only (computed once);
@@ -26,12 +46,25 @@ MW_BACKEND_BEGIN
 // the candidates lie beyond h; heat.hpp's grid rows, which read more per candidate, gain from
 // it). A particle of an object flagged in
 // `lattice_object` (indexed by object, empty for static particles) weighs `lattice_volume`.
+//
+// `read_reach2` > 0 (moving solids without heat): only a particle that some fluid particle reads
+// gets its volume, the others 0. The fluid reads b in its density, pressure, viscosity and tension
+// sums, and the reaction reads b's own, only where a fluid particle lies in b's 27 cells (grid
+// mode: the relation is symmetric) or within h of it (lists, built every step with the same test):
+// `read_reach2` is h² with lists and any distance on the grid. Inside a large object, and before
+// the fluid arrives, that is most of its particles (tests/core/test_kernels.cpp checks the volumes
+// read are unchanged).
 template <class Kernel>
 void compute_boundary_volumes(const DeviceContext& device, GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
                               std::size_t count, bool moving, Kernel kernel, View<const std::int32_t> object = {},
-                              View<const std::uint8_t> lattice_object = {}, Real lattice_volume = 0) {
+                              View<const std::uint8_t> lattice_object = {}, Real lattice_volume = 0,
+                              Real read_reach2 = 0) {
     parallel_for(device, "boundary_volume", count, [=] MW_HD(std::size_t k) {
         const std::size_t b = first + k;
+        if (read_reach2 > Real(0) && !fluid_within(grid, position, position[b], read_reach2)) {
+            volume[b] = 0;
+            return;
+        }
         if (lattice_object.size() != 0) {
             const std::int32_t o = object[b];
             if (o >= 0 && std::size_t(o) < lattice_object.size() && lattice_object[std::size_t(o)]) {
@@ -54,7 +87,7 @@ class BoundaryVolumes final : public Module {
     // `moving_solids`: the scene has elastic or rigid objects; `heat`: it conducts heat, which
     // reads the solids' volumes even without fluid.
     BoundaryVolumes(SimulationState<Kernel>& state, const SimulationSetup& setup, bool moving_solids, bool heat)
-        : state_(state), moving_solids_(moving_solids), per_step_(moving_solids && state.has_fluid) {
+        : state_(state), moving_solids_(moving_solids), per_step_(moving_solids && state.has_fluid), all_moving_(heat) {
         const ParticleStore& store = state.store;
         // Only fluid next to boundary particles reads them: without fluid (but for heat), or
         // without any boundary particle, they are neither stored nor computed. Indexed like the
@@ -78,14 +111,21 @@ class BoundaryVolumes final : public Module {
     }
 
     void bind(StepPlan& plan) override {
-        if (per_step_) plan.bind("solid_volumes", [this](StepContext& step) { update_moving(step.neighbors.grid, step.ranges); });
+        if (per_step_)
+            plan.bind("solid_volumes", [this](StepContext& step) {
+                update_moving(step.neighbors.grid, step.ranges, step.neighbors.use_lists);
+            });
     }
 
-    // The moving solids' boundary particles' volumes, over the current grid.
-    void update_moving(const GridView& grid, const GroupRanges& ranges) {
+    // The moving solids' boundary particles' volumes, over the current grid: with heat all of
+    // them (it conducts between solid particles), otherwise those the fluid reads (`lists`: the
+    // fluid's neighbour lists, else the grid, gather them).
+    void update_moving(const GridView& grid, const GroupRanges& ranges, bool lists = false) {
+        const Real h = state_.fluid.kernel.h;
+        const Real read_reach2 = all_moving_ ? Real(0) : lists ? h * h : std::numeric_limits<Real>::max();
         compute_boundary_volumes(state_.device, grid, state_.store.position.cview(), volume_.view(), ranges.fluid_end,
                                  ranges.solid_end - ranges.fluid_end, true, state_.fluid.kernel, state_.store.object.cview(),
-                                 lattice_object_.cview(), lattice_volume_);
+                                 lattice_object_.cview(), lattice_volume_, read_reach2);
     }
     bool moving_solids() const { return moving_solids_; }
     // Whether the step keeps them current (fluid and moving solids).
@@ -96,6 +136,7 @@ class BoundaryVolumes final : public Module {
    private:
     SimulationState<Kernel>& state_;
     bool moving_solids_ = false, per_step_ = false;
+    bool all_moving_ = false;                    // heat reads every moving particle's volume
     DeviceArray<Real> volume_;                   // V_b, indexed like the store
     DeviceArray<std::uint8_t> lattice_object_;   // per object: 1 for a melting object's lattice (empty: none)
     Real lattice_volume_ = 0;                    // a fluid particle's volume m/ρ0

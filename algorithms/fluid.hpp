@@ -150,7 +150,8 @@ class Fluid final : public Module {
             // The first prediction has no pressure acceleration yet (nothing to clear beforehand).
             const bool first = iterations == 0;
             if (step.pressure_response) step.pressure_response->before_iteration(step, dt, iterations);
-            if (step.lookahead.velocity && !solid_met_.empty()) {
+            // The placement changes within a try only where objects answer inside the solve.
+            if (step.lookahead.velocity && !solid_met_.empty() && (first || step.pressure_response)) {
                 place_moving_solids(device, step.lookahead, store.position.cview(), solid_met_.view().data());
                 step.lookahead.met = solid_met_.view().data();
             }

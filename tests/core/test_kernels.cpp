@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <utility>
@@ -564,4 +565,78 @@ TEST_CASE("viscosity next to a free-slip wall: the mirror images are symmetric a
     MESSAGE("uniform flow into the corner: power " << with_images << " W with images, " << without << " W without");
     CHECK(without == 0);
     CHECK(with_images < 0);
+}
+
+// The moving solids' volumes are computed only where the fluid reads them (boundary_volumes.hpp):
+// every solid particle with fluid within h gets the full sum's value to the bit, those with no
+// fluid in reach get 0, and a block of solid beside a block of fluid has both kinds.
+TEST_CASE("moving solids' Akinci volumes: computed where the fluid reads them, equal to the full sum there") {
+    const Real r0 = Real(0.02);
+    const CubicSpline3D kernel = CubicSpline3D::with_support(2 * r0);
+    const Real h = kernel.h;
+    std::vector<Vec3> position;
+    std::vector<std::uint8_t> type;
+    // Fluid in x < 6 r0, a solid block beside it to x = 18 r0 (SBPs, as the grid groups them).
+    for (int i = 0; i < 18; ++i)
+        for (int j = 0; j < 6; ++j)
+            for (int k = 0; k < 6; ++k) {
+                position.push_back(Vec3{(Real(i) + Real(0.5)) * r0, (Real(j) + Real(0.5)) * r0, (Real(k) + Real(0.5)) * r0});
+                type.push_back(i < 6 ? std::uint8_t(kFluid) : std::uint8_t(kSurfaceBoundary));
+            }
+    const std::size_t n = position.size();
+    for (const auto& [ordering, cells_per_h] : {std::pair{CellOrdering::kZOrder, 1}, std::pair{CellOrdering::kLinear, 1},
+                                                std::pair{CellOrdering::kZOrder, 2}}) {
+        CAPTURE(int(ordering));
+        CAPTURE(cells_per_h);
+        const DeviceContext device;
+        ParticleStore store(device);
+        store.resize(n, n);
+        std::vector<std::uint32_t> id(n);
+        std::iota(id.begin(), id.end(), 0u);
+        store.id.upload(id);
+        store.position.upload(position);
+        store.velocity.upload(std::vector<Vec3>(n, Vec3{0, 0, 0}));
+        store.type.upload(type);
+        store.object.fill(-1);
+        NeighborGrid grid(device);
+        grid.configure(Vec3{-h, -h, -h}, Vec3{18 * r0 + h, 6 * r0 + h, 6 * r0 + h}, h, ordering, cells_per_h);
+        const GroupRanges ranges = grid.build(store);
+        REQUIRE(ranges.fluid_end == 6 * 36);
+        REQUIRE(ranges.solid_end == n);
+        const std::size_t count = ranges.solid_end - ranges.fluid_end;
+        auto volumes = [&](Real read_reach2) {
+            DeviceArray<Real> volume(n);
+            volume.fill(Real(-1));
+            compute_boundary_volumes(device, grid.view(), store.position.cview(), volume.view(), ranges.fluid_end, count, true,
+                                     kernel, {}, {}, 0, read_reach2);
+            return volume.to_host();
+        };
+        const std::vector<Real> all = volumes(0), lists = volumes(h * h), cells = volumes(std::numeric_limits<Real>::max());
+        const std::vector<Vec3> x = store.position.to_host();
+        std::size_t read = 0, skipped_lists = 0, skipped_cells = 0;
+        for (std::size_t b = ranges.fluid_end; b < ranges.solid_end; ++b) {
+            CAPTURE(b);
+            Real nearest2 = std::numeric_limits<Real>::max();
+            for (std::size_t i = 0; i < ranges.fluid_end; ++i) nearest2 = std::min(nearest2, norm2(x[i] - x[b]));
+            REQUIRE(all[b] > Real(0));
+            if (nearest2 < h * h) {  // in some fluid particle's sums
+                ++read;
+                CHECK(lists[b] == all[b]);
+                CHECK(cells[b] == all[b]);
+            } else {
+                CHECK(lists[b] == Real(0));
+                skipped_lists += lists[b] == Real(0);
+            }
+            // Beyond any 27 cells of size h around a fluid particle.
+            if (nearest2 > Real(12) * h * h) {
+                CHECK(cells[b] == Real(0));
+                ++skipped_cells;
+            } else if (cells[b] != Real(0)) {
+                CHECK(cells[b] == all[b]);
+            }
+        }
+        CHECK(read >= 36 * 2);  // the block's first two layers at least
+        CHECK(skipped_lists > count / 2);
+        CHECK(skipped_cells > 0);
+    }
 }
