@@ -29,6 +29,7 @@
 #include "algorithms/lsm.hpp"
 #include "algorithms/lsm_regions.hpp"
 #include "algorithms/neighbor_grid.hpp"
+#include "algorithms/particle_types.hpp"
 #include "algorithms/pcisph.hpp"
 #include "algorithms/solid_face.hpp"
 
@@ -100,6 +101,13 @@ struct CouplingData {
     // SBPs' face points.
     const Real* sbp_eta = nullptr;
     SbpFaces faces;
+    // The same per IBP slot for a melting object's lattice, and the store's types: only its
+    // exposed vertices (kSurfaceBoundary) pull, toward their faces, `lattice_inset` in front of
+    // them along their normals (melting_faces.hpp); null: none.
+    const Real* lattice_eta = nullptr;
+    const std::uint8_t* type = nullptr;
+    const Vec3* lattice_normal = nullptr;
+    Real lattice_inset = 0;
     // Inside PCISPH (coupling.strong): only the slots of the objects that answer there (rigid
     // and solid elastic ones, cloths: LsmObjectParams::answers) are gathered (each slot's object, and the
     // objects' parameters); null: every slot.
@@ -172,11 +180,14 @@ void fluid_reaction_on_solids(const DeviceContext& device, const FluidPairs pair
         // the correction's impulses.
         if (listed != 0) {
             const Vec3 xb = position[b], vb = velocity[b];
-            const Real eta = d.sbp_eta && s >= d.ibp_count ? d.sbp_eta[s - d.ibp_count] : Real(0);
+            const Real eta = s >= d.ibp_count ? (d.sbp_eta ? d.sbp_eta[s - d.ibp_count] : Real(0))
+                                               : (d.lattice_eta && d.type[b] == kSurfaceBoundary ? d.lattice_eta[s] : Real(0));
             Vec3 pressure_sum{0, 0, 0}, friction_sum{0, 0, 0}, tension_sum{0, 0, 0};
             // Where this iteration's sums met b (its placement is kept for them; pcisph.hpp).
             const Vec3 xb_met = pairs.lookahead.met_position(b, position);
-            const Vec3 xb_face = eta > Real(0) ? d.faces.at(xb, static_cast<std::uint32_t>(s - d.ibp_count)) : xb;
+            const Vec3 xb_face = !(eta > Real(0)) ? xb
+                                 : s >= d.ibp_count ? d.faces.at(xb, static_cast<std::uint32_t>(s - d.ibp_count))
+                                                    : xb + d.lattice_inset * d.lattice_normal[s];
             const Real h2 = c.kernel.h * c.kernel.h;
             const auto add = [&](std::uint32_t i, Real paired) {
                 const Vec3 xi = position[i];

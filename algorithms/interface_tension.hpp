@@ -5,7 +5,10 @@
 //   F_{i<-s} = -η_s m_i ψ_s W(x_is, h) x_is / |x_is|,   ψ_s = ρ0 V_s,  x_is = x_i - x_s,
 //
 // a non-pressure force, from the positions at the start of the step (like viscosity), with x_s
-// the SBP's face point (solid_face.hpp) over the pairs within h of the SBP itself. Its
+// the SBP's face point (solid_face.hpp) over the pairs within h of the SBP itself. A melting
+// object's surface particles are its exposed lattice vertices (melting.hpp): x_s is then the
+// vertex's cell face, r0/2 in front of it along its normal (melting_faces.hpp), or the vertex
+// where it has no outside. Its
 // reaction F_{s<-i} = -F_{i<-s} goes back to the object with the other coupling forces
 // (coupling.hpp), over the same pairs: every pair within h, which the 27 cells around either
 // particle hold, so the pair's two forces cancel to rounding.
@@ -31,8 +34,11 @@ MW_BACKEND_BEGIN
 struct TensionData {
     View<const std::uint8_t> type;  // store fields
     View<const std::int32_t> solid_slot;
-    const Real* sbp_eta = nullptr;  // η per SBP index; null: no tension anywhere
+    const Real* sbp_eta = nullptr;  // η per SBP index; null: none on any SBP
     SbpFaces faces;                 // where each SBP meets the fluid (solid_face.hpp)
+    const Real* lattice_eta = nullptr;  // η per IBP slot, a melting object's; null: none
+    const Vec3* lattice_normal = nullptr;  // its exposed vertices' normals (melting_faces.hpp)
+    Real lattice_inset = 0;                // m: their faces lie this far in front of them (r0/2)
     std::uint32_t ibp_count = 0;    // SBP k has solid slot ibp_count + k
 };
 
@@ -46,17 +52,29 @@ void add_interface_tension(const DeviceContext& device, GridView grid, std::size
         const Vec3 xi = position[i];
         Vec3 sum{0, 0, 0};
         grid.for_each_solid(xi, [&](std::uint32_t b) {
-            // A melting object's SBPs (IBP slots, melting.hpp) take no tension yet.
-            if (t.type[b] != kSurfaceBoundary || std::uint32_t(t.solid_slot[b]) < t.ibp_count) return;
-            // The pair: within h of the SBP (as the coupling's reaction pairs them); the pull:
-            // toward its face point.
+            if (t.type[b] != kSurfaceBoundary) return;
+            // The pair: within h of the SBP (as the coupling's reaction pairs them).
             if (!(norm2(xi - position[b]) < kernel.h * kernel.h)) return;
-            const std::uint32_t s = static_cast<std::uint32_t>(t.solid_slot[b]) - t.ibp_count;
-            const Vec3 r = xi - t.faces.at(position[b], s);
+            // The pull: toward an SBP's face point; for a melting lattice's exposed vertex (an IBP
+            // slot, melting.hpp), toward its cell's face, r0/2 in front of it (on the vertex where
+            // it has no outside), where the correction meets it too.
+            const std::uint32_t slot = static_cast<std::uint32_t>(t.solid_slot[b]);
+            Real eta = 0;
+            Vec3 toward = position[b];
+            if (slot >= t.ibp_count) {
+                if (!t.sbp_eta) return;
+                eta = t.sbp_eta[slot - t.ibp_count];
+                toward = t.faces.at(position[b], slot - t.ibp_count);
+            } else if (t.lattice_eta) {
+                eta = t.lattice_eta[slot];
+                toward = position[b] + t.lattice_inset * t.lattice_normal[slot];
+            }
+            if (!(eta > Real(0))) return;
+            const Vec3 r = xi - toward;
             const Real r2 = norm2(r);
             const Real w = kernel.W_r2(r2);
             if (!(w > Real(0)) || !(r2 > Real(0))) return;
-            sum += (t.sbp_eta[s] * boundary_volume[b] * w / std::sqrt(r2)) * r;
+            sum += (eta * boundary_volume[b] * w / std::sqrt(r2)) * r;
         });
         const Vec3 a = -rest_density * sum;
         acceleration[i] = accumulate ? acceleration[i] + a : gravity + a;
@@ -88,6 +106,9 @@ class InterfaceTension final : public Module {
         t.type = state_.store.type.cview();
         t.solid_slot = solids_.solid_slot_view();
         t.sbp_eta = solids_.sbp_eta();
+        t.lattice_eta = solids_.lattice_eta();
+        t.lattice_normal = solids_.lattice_normals();
+        t.lattice_inset = Real(0.5) * state_.params.fluid.spacing;
         t.faces = solids_.sbp_faces();
         t.ibp_count = static_cast<std::uint32_t>(solids_.ibp_count());
         add_interface_tension(state_.device, step.neighbors.grid, step.ranges.fluid_end, state_.store.position.cview(),

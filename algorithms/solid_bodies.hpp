@@ -155,15 +155,7 @@ class SolidBodies final : public Module {
         moving_names_.clear();
         for (std::size_t o = 0; o < object_count_; ++o)
             moving_names_.push_back(setup.solids[o].kind != SolidKind::kStatic ? setup.solids[o].name : "");
-        // Interface tension (interface_tension.hpp): each SBP's η, its object's; none stored when
-        // no object has any.
-        std::vector<Real> sbp_eta(sbp_count_, Real(0));
-        bool any_tension = false;
-        for (std::size_t k = 0; k < sbp_count_; ++k) {
-            sbp_eta[k] = setup.solids[std::size_t(sbp_object_[k])].interface_tension;
-            any_tension = any_tension || sbp_eta[k] > Real(0);
-        }
-        if (any_tension) sbp_eta_.upload(sbp_eta);
+        upload_tension(setup, L.ibp_object);
         // Two-way coupling, only where there is fluid to push the solids (coupling.hpp); its
         // forces act through the regions (lsm.hpp, LsmData::forces).
         // A melting object makes fluid of its own (melting.hpp), and an emitter brings some
@@ -198,10 +190,30 @@ class SolidBodies final : public Module {
         if (!melting_.empty()) host_layout_ = std::move(L);
         // The correction against the melting lattices' exposed vertices (melting_faces.hpp):
         // their normals, and two-way their contact masses and impulses, by IBP slot.
-        lattice_normal_.assign(!melting_.empty() && setup.params.coupling.correction ? ibp_count_ : 0, Vec3{0, 0, 0});
-        const bool lattice_takes_impulses = !lattice_normal_.empty() && !reaction_.empty();
+        // Interface tension on a melting object pulls toward the same faces, so it needs the
+        // normals too.
+        lattice_faces_met_ = !melting_.empty() && setup.params.coupling.correction;
+        lattice_normal_.assign(lattice_faces_met_ || !lattice_eta_.empty() ? ibp_count_ : 0, Vec3{0, 0, 0});
+        const bool lattice_takes_impulses = lattice_faces_met_ && !reaction_.empty();
         lattice_inverse_mass_.assign(lattice_takes_impulses ? ibp_count_ : 0, Real(0));
         lattice_impulse_.assign(lattice_takes_impulses ? ibp_count_ : 0, Vec3{0, 0, 0});
+    }
+
+    // Interface tension (interface_tension.hpp): each SBP's η, its object's, and each melting
+    // object's lattice vertex's (IBP slots: its surface is its exposed vertices); none stored
+    // where no object has any.
+    void upload_tension(const SimulationSetup& setup, const std::vector<std::int32_t>& ibp_object) {
+        auto upload = [&](DeviceArray<Real>& out, std::size_t count, auto eta_of) {
+            std::vector<Real> eta(count, Real(0));
+            bool any = false;
+            for (std::size_t k = 0; k < count; ++k) any = (eta[k] = eta_of(k)) > Real(0) || any;
+            if (any) out.upload(eta);
+        };
+        upload(sbp_eta_, sbp_count_, [&](std::size_t k) { return setup.solids[std::size_t(sbp_object_[k])].interface_tension; });
+        upload(lattice_eta_, ibp_count_, [&](std::size_t k) {
+            const SolidSetup& solid = setup.solids[std::size_t(ibp_object[k])];
+            return solid.melts() ? solid.interface_tension : Real(0);
+        });
     }
 
     // A melting object's lattice: its index in the setup's solids, its first IBP slot, its
@@ -467,6 +479,11 @@ class SolidBodies final : public Module {
         if (!sbp_impulse_.empty()) c.sbp_contact_impulse = sbp_impulse_.view().data();
         if (!lattice_impulse_.empty()) c.lattice_contact_impulse = lattice_impulse_.view().data();
         if (!sbp_eta_.empty()) c.sbp_eta = sbp_eta_.view().data();
+        if (!lattice_eta_.empty()) {
+            c.lattice_eta = lattice_eta_.view().data();
+            c.type = store_->type.cview().data();
+            c.lattice_normal = lattice_normal_.view().data();
+        }
         c.faces = sbp_faces();
         return c;
     }
@@ -482,7 +499,7 @@ class SolidBodies final : public Module {
         c.sbp_inset = sbp_faces().inset;
         if (!sbp_sides_.empty()) c.sbp_sides = sbp_sides_.view().data();
         if (!sbp_inverse_mass_.empty()) c.sbp_inverse_mass = sbp_inverse_mass_.view().data();
-        if (!lattice_normal_.empty()) c.lattice_normal = lattice_normal_.view().data();
+        if (lattice_faces_met_) c.lattice_normal = lattice_normal_.view().data();
         if (!lattice_inverse_mass_.empty()) c.lattice_inverse_mass = lattice_inverse_mass_.view().data();
         c.lattice_inset = Real(0.5) * reach;
         c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
@@ -519,8 +536,10 @@ class SolidBodies final : public Module {
         return f;
     }
     // Interface tension (interface_tension.hpp): whether any object has it, and its eta per SBP.
-    bool has_tension() const { return !sbp_eta_.empty(); }
+    bool has_tension() const { return !sbp_eta_.empty() || !lattice_eta_.empty(); }
     const Real* sbp_eta() const { return sbp_eta_.empty() ? nullptr : sbp_eta_.view().data(); }
+    // The same per IBP slot for the melting objects' lattices (null: none with tension).
+    const Real* lattice_eta() const { return lattice_eta_.empty() ? nullptr : lattice_eta_.view().data(); }
 
 
     // The force on each object's IBPs in the last step (N, summed in double on the host),
@@ -550,7 +569,10 @@ class SolidBodies final : public Module {
     }
     bool surface_inset() const { return !sbp_inset_.empty(); }
     // Whether the correction meets melting lattices, whose faces lie in front of their vertices.
-    bool lattice_faces_met() const { return !lattice_normal_.empty(); }
+    bool lattice_faces_met() const { return lattice_faces_met_; }
+    // The melting lattices' exposed vertices' normals, by IBP slot (null: not computed), for
+    // interface tension's face points.
+    const Vec3* lattice_normals() const { return lattice_normal_.empty() ? nullptr : lattice_normal_.view().data(); }
 
     // Checkpoints (state_archive.hpp): what the solids carry from one step to the next. The
     // layout (rest shape, regions, links) is rebuilt from the scene; this is the rest: the
@@ -581,7 +603,7 @@ class SolidBodies final : public Module {
                objects_.bytes() + gp_rest_.bytes() + gp_offsets_.bytes() + gp_links_.bytes() + gp_weights_.bytes() +
                sbp_.bytes() + sbp_normal_.bytes() + sbp_sides_.bytes() + sbp_inset_.bytes() + reaction_.bytes() + share_offsets_.bytes() + share_sbp_.bytes() +
                share_weight_.bytes() + sbp_inverse_mass_.bytes() + sbp_impulse_.bytes() + lattice_normal_.bytes() +
-               lattice_inverse_mass_.bytes() + lattice_impulse_.bytes() + sbp_eta_.bytes() +
+               lattice_inverse_mass_.bytes() + lattice_impulse_.bytes() + sbp_eta_.bytes() + lattice_eta_.bytes() +
                object_ibp_begin_.bytes() + object_velocity_.bytes() + wall_impulse_.bytes() +
                body_motion_.bytes() + contact_.bytes();
     }
@@ -766,9 +788,11 @@ class SolidBodies final : public Module {
     DeviceArray<Real> sbp_inverse_mass_;
     DeviceArray<Vec3> sbp_impulse_;
     DeviceArray<Vec3> lattice_normal_;        // per IBP slot, with a melting object (melting_faces.hpp)
+    bool lattice_faces_met_ = false;          // the correction meets the melting lattices' faces
     DeviceArray<Real> lattice_inverse_mass_;  // per IBP slot, the same, two-way
     DeviceArray<Vec3> lattice_impulse_;       // per IBP slot, the same, two-way
     DeviceArray<Real> sbp_eta_;  // interface tension η per SBP (empty: none)
+    DeviceArray<Real> lattice_eta_;  // ... per IBP slot, a melting object's (empty: none)
     DeviceArray<std::uint32_t> object_ibp_begin_;  // per object, its first IBP slot (and one past the last)
     DeviceArray<Vec3> object_velocity_;            // per object, this step's mean velocity
     mutable DeviceArray<Vec3> object_centroid_;    // per object, its centre of mass (report())

@@ -52,7 +52,7 @@ inline const ParamTable<SolidParams>& solid_keys() {
                                   "the solid's density"));
         t.push_back(number_key<T>("objects[]", "interface_tension", member(&T::interface_tension),
                                   ParamRange::non_negative(), "m4/(kg s2)",
-                                  "eta of Eq. 9: fluid drawn to its surface (elastic and rigid objects)"));
+                                  "eta of Eq. 9: fluid drawn to its surface (moving objects, melting ones included)"));
         t.push_back(number_key<T>("objects[]", "thermal_diffusivity", member(&T::thermal_diffusivity),
                                   ParamRange::non_negative(), "m2/s", "alpha, with heat.enabled")
                         .derive_default([](const ResolvedKeys& r) { return *r.find("fluid.thermal_diffusivity"); },

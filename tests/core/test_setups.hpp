@@ -424,15 +424,19 @@ struct CubeThrow {
         for (std::size_t i = 0; lattice != Lattice::kNone && i < setup.position.size(); ++i)
             setup.temperature.push_back(Real(setup.object[i] < 0 ? 20 : 0));
         ibp_mass = solid.density * double(r0) * r0 * r0;
+        melting_lattice = lattice != Lattice::kNone;
     }
-    // Total momentum along x of the fluid and of the IBPs (SBPs and GPs carry no mass).
+    // Total momentum along x of the fluid and of the IBPs (SBPs and GPs carry no mass, but a
+    // melting lattice's exposed vertices, its SBPs, are IBPs that do).
     void momentum(const HostParticles& p, double& fluid, double& solid) const {
         fluid = solid = 0;
         for (std::size_t i = 0; i < p.position.size(); ++i) {
             if (p.type[i] == kFluid) fluid += fluid_mass * p.velocity[i].x;
-            if (p.type[i] == kInnerBoundary) solid += ibp_mass * p.velocity[i].x;
+            if (p.type[i] == kInnerBoundary || (melting_lattice && p.type[i] == kSurfaceBoundary))
+                solid += ibp_mass * p.velocity[i].x;
         }
     }
+    bool melting_lattice = false;  // the cube is a melting object's lattice
 };
 
 }  // namespace mw::test
