@@ -21,7 +21,8 @@
 //   7b. The extremes: scenes/thrown_cube.json (a 0.12 m cube thrown down at 5 m/s into a pool)
 //      rigid (with and without coupling.strong) and elastic, at 100, 500, 2,000 and 10,000 kg/m³,
 //      at CFL 0.4 and at CFL 1 under 30 ms: whether it runs to the end, steps, time, and how the
-//      cube ends.
+//      cube ends; and a flat box (0.24 x 0.08 x 0.24 m) of 2,000 to 10,000 kg/m³ let go from rest
+//      under water onto the film over the floor, the same way.
 //   7c. The largest steps: the same throws at CFL 0.4, 0.7 and 1 (steps up to 30 ms) and at fixed
 //      steps of 1 to 30 ms, each judged as tests/core/test_extremes.cpp judges its cases: up to
 //      which setting a case holds, and how the next one fails.
@@ -368,6 +369,46 @@ std::string table2_row(const Options& o, const std::string& label, const std::st
            std::to_string(triangles) + " triangles; the paper's resolution is not given.\n\n";
 }
 
+
+// One run of scenes/thrown_cube.json with `overrides` to `end_time`, or to the guard that stops it
+// (docs/solver.md, "Guards"): how it ended, its steps and seconds, the fluid's top speed, and at
+// the end the fastest IBP and the object's centre height.
+struct ExtremeRun {
+    std::string ended = "ran";
+    long steps = 0, fluid = 0;
+    double seconds = 0, top_fluid = 0, fastest_ibp = 0, centre = 0;
+};
+ExtremeRun run_thrown_cube(const Options& o, const std::vector<std::string>& overrides, double end_time) {
+    const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/thrown_cube.json", overrides);
+    const SimulationSetup setup = build_setup(scene);
+    const double limit = speed_limit(scene, setup).limit;
+    auto sim = make(o, setup);
+    ExtremeRun out;
+    out.fluid = sim->counts().by_type[kFluid];
+    double ms = 0;
+    try {
+        while (sim->time() < end_time) {
+            sim->step();
+            const StepReport& rep = sim->last_report();
+            ++out.steps;
+            ms += rep.total_ms;
+            out.top_fluid = std::max(out.top_fluid, rep.max_speed);
+            if (!(rep.max_speed < limit) || !(rep.solid_max_speed < limit)) {
+                char at[64];
+                std::snprintf(at, sizeof at, "runaway at %.3f s", sim->time());
+                out.ended = at;
+                break;
+            }
+        }
+    } catch (const std::exception& e) {
+        out.ended = std::string("stopped: ") + e.what();
+    }
+    const StepReport& last = sim->last_report();
+    out.seconds = ms / 1000;
+    out.fastest_ibp = last.solid_max_speed;
+    out.centre = last.has("centroid_cube_y") ? last.value("centroid_cube_y") : 0.0;
+    return out;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -664,44 +705,20 @@ int main(int argc, char** argv) {
                 for (const char* density : {"100", "500", "2000", "10000"})
                     for (const char* cfl : {"0.4", "1"}) {
                         const char* kind = k.kind;
-                        const Scene scene = load_scene(std::string(MW_SOURCE_DIR) + "/scenes/thrown_cube.json",
-                                                       {std::string("objects.0.kind=\"") + kind + "\"",
-                                                        std::string("objects.0.density=") + density,
-                                                        std::string("solver.cfl_number=") + cfl,
-                                                        std::string("coupling.strong=") + k.strong});
-                        const SimulationSetup setup = build_setup(scene);
-                        const double limit = speed_limit(scene, setup).limit;
-                        auto sim = make(o, setup);
-                        fluid = sim->counts().by_type[kFluid];
-                        long steps = 0;
-                        double ms = 0, top_fluid = 0;
-                        std::string ended = "ran";
-                        try {
-                            while (sim->time() < end_time) {
-                                sim->step();
-                                const StepReport& rep = sim->last_report();
-                                ++steps;
-                                ms += rep.total_ms;
-                                top_fluid = std::max(top_fluid, rep.max_speed);
-                                if (!(rep.max_speed < limit) || !(rep.solid_max_speed < limit)) {
-                                    char at[64];
-                                    std::snprintf(at, sizeof at, "runaway at %.3f s", sim->time());
-                                    ended = at;
-                                    break;
-                                }
-                            }
-                        } catch (const std::exception& e) {
-                            ended = std::string("stopped: ") + e.what();
-                        }
-                        const StepReport& last = sim->last_report();
-                        const double centre = last.has("centroid_cube_y") ? last.value("centroid_cube_y") : 0.0;
+                        const ExtremeRun r = run_thrown_cube(
+                            o,
+                            {std::string("objects.0.kind=\"") + kind + "\"", std::string("objects.0.density=") + density,
+                             std::string("solver.cfl_number=") + cfl, std::string("coupling.strong=") + k.strong},
+                            end_time);
+                        fluid = r.fluid;
                         char cell[400];
                         const char* strong = std::string(kind) == "rigid" ? (std::string(k.strong) == "true" ? "on" : "off") : "-";
                         std::snprintf(cell, sizeof cell, "| %s | %s | %s | %s | %s | %ld | %.2f | %.2f | %.3f | %.3f |\n", kind,
-                                      strong, density, cfl, ended.c_str(), steps, ms / 1000, top_fluid, last.solid_max_speed, centre);
+                                      strong, density, cfl, r.ended.c_str(), r.steps, r.seconds, r.top_fluid, r.fastest_ibp,
+                                      r.centre);
                         rows += cell;
                         std::fprintf(stderr, "  extremes %-8s strong %-3s %6s kg/m3 CFL %-4s %s, %ld steps\n", kind, strong,
-                                     density, cfl, ended.c_str(), steps);
+                                     density, cfl, r.ended.c_str(), r.steps);
                     }
             std::ostringstream t;
             t << "### The extremes (scenes/thrown_cube.json: " << fluid << " fluid particles, a 0.12 m cube thrown down "
@@ -710,6 +727,37 @@ int main(int argc, char** argv) {
                  "centre height at the end m |\n|---|---|---|---|---|---|---|---|---|---|\n"
               << rows;
             emit(t.str() + "\nOn the floor the cube's centre is at 0.06 m; floating, 0.25 m less its draft plus 0.06 m.\n\n");
+            // A flat body landing flat: the same pool, a box 0.24 x 0.08 x 0.24 m let go from rest
+            // under water, its broad face down, onto the film over the floor (docs/validation.md,
+            // "A flat body landing flat").
+            std::string flat_rows;
+            for (const ExtremeKind k : {ExtremeKind{"rigid", "true"}, ExtremeKind{"rigid", "false"}, ExtremeKind{"elastic", "true"}})
+                for (const char* density : {"2000", "3000", "10000"})
+                    for (const char* cfl : {"0.4", "1"}) {
+                        const ExtremeRun r = run_thrown_cube(
+                            o,
+                            {"objects.0.mesh.procedural=\"box:x=0.24,y=0.08,z=0.24\"", "objects.0.transform.translation=[0.3,0.15,0.2]",
+                             "objects.0.velocity=[0,0,0]", std::string("objects.0.kind=\"") + k.kind + "\"",
+                             std::string("objects.0.density=") + density, std::string("solver.cfl_number=") + cfl,
+                             std::string("coupling.strong=") + k.strong},
+                            end_time);
+                        char cell[400];
+                        const char* strong = std::string(k.kind) == "rigid" ? (std::string(k.strong) == "true" ? "on" : "off") : "-";
+                        std::snprintf(cell, sizeof cell, "| %s | %s | %s | %s | %s | %ld | %.2f | %.2f | %.3f | %.3f |\n", k.kind,
+                                      strong, density, cfl, r.ended.c_str(), r.steps, r.seconds, r.top_fluid, r.fastest_ibp,
+                                      r.centre);
+                        flat_rows += cell;
+                        std::fprintf(stderr, "  flat landing %-8s strong %-3s %6s kg/m3 CFL %-4s %s, %ld steps\n", k.kind, strong,
+                                     density, cfl, r.ended.c_str(), r.steps);
+                    }
+            std::ostringstream f;
+            f << "### A flat body landing flat (scenes/thrown_cube.json with a box 0.24 x 0.08 x 0.24 m let go from rest, its "
+                 "centre 0.15 m up; steps up to 30 ms; to t = "
+              << end_time << " s)\n\n"
+              << "| kind | coupling.strong | kg/m3 | CFL | end | steps | s | top fluid speed m/s | fastest IBP at the end m/s | box's "
+                 "centre height at the end m |\n|---|---|---|---|---|---|---|---|---|---|\n"
+              << flat_rows;
+            emit(f.str() + "\nOn the floor the box's centre is at 0.04 m; on a film of one fluid layer, 0.06 m.\n\n");
         }
         // The largest steps (scenes/thrown_cube.json): each case of the extremes at rising CFL
         // numbers, judged as tests/core/test_extremes.cpp judges its cases (ran to the end, nothing
