@@ -3,6 +3,7 @@
 // the step's halving in CFL mode) and "integrate" (symplectic Euler and the walls' correction).
 #pragma once
 #include <algorithm>
+#include <stdexcept>
 
 #include "algorithms/boundary_volumes.hpp"
 #include "algorithms/module.hpp"
@@ -28,7 +29,10 @@ class Fluid final : public Module {
         pressure_term_.resize(moving);
         predicted_.resize(moving);
         if (has_viscosity_ || tension) nonpressure_.resize(moving);
-        if (volumes.moving_solids()) solid_met_.resize(moving);
+        // One place per particle of the solids' group (SBPs and IBPs): melting and particles lost
+        // from the grid only ever shrink it.
+        if (volumes.moving_solids())
+            solid_met_.resize(state.counts.by_type[kSurfaceBoundary] + state.counts.by_type[kInnerBoundary]);
     }
 
     void bind(StepPlan& plan) override {
@@ -152,6 +156,8 @@ class Fluid final : public Module {
             if (step.pressure_response) step.pressure_response->before_iteration(step, dt, iterations);
             // The placement changes within a try only where objects answer inside the solve.
             if (step.lookahead.velocity && !solid_met_.empty() && (first || step.pressure_response)) {
+                if (step.lookahead.end - step.lookahead.begin > solid_met_.size())
+                    throw std::logic_error("PCISPH: more moving solid particles than at the start");
                 place_moving_solids(device, step.lookahead, store.position.cview(), solid_met_.view().data());
                 step.lookahead.met = solid_met_.view().data();
             }
