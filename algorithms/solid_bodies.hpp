@@ -669,9 +669,10 @@ class SolidBodies final : public Module {
         g.sbp_normal = sbp_normal_.view().data();
         if (!sbp_inset_.empty()) {
             g.sbp_inset = sbp_inset_.view().data();
-            g.wall_lo = domain_min_;
-            g.wall_hi = domain_max_;
+            g.wall_lo = fade_lo_;
+            g.wall_hi = fade_hi_;
             g.inset_fade = inset_fade_;
+            g.boxes = contact_.obstacles().boxes;
         }
         return g;
     }
@@ -689,14 +690,14 @@ class SolidBodies final : public Module {
             return;
         }
         const BoundaryParams& b = setup.params.boundary;
-        inset_fade_ = surface_inset_fade(b.walls, setup.params.fluid.support_radius, b.wall_gap);
+        inset_fade_ = surface_inset_fade(b.walls, setup.params.fluid.support_radius, b.wall_gap, b.static_boxes);
+        faces_to_fade_at(b.walls, setup.params.domain_min, setup.params.domain_max, fade_lo_, fade_hi_);
         std::vector<Real> start(L.sbp_count);
         for (std::size_t k = 0; k < L.sbp_count; ++k) {
             const SbpLink& link = L.sbp[k];
             const Vec3 face = link.bary.x * L.gp_rest[link.corner[0]] + link.bary.y * L.gp_rest[link.corner[1]] +
                               link.bary.z * L.gp_rest[link.corner[2]];
-            start[k] = faded_inset(link.inset, face, L.sbp_normal[k], setup.params.domain_min, setup.params.domain_max,
-                                   inset_fade_);
+            start[k] = faded_inset(link.inset, face, L.sbp_normal[k], fade_lo_, fade_hi_, inset_fade_, b.static_boxes);
         }
         sbp_inset_.upload(start);
         largest_inset_ = largest;
@@ -778,6 +779,7 @@ class SolidBodies final : public Module {
     DeviceArray<std::uint8_t> sbp_sides_;  // SbpSides; empty: every SBP one-sided (no cloth or rod)
     DeviceArray<Real> sbp_inset_;  // m, by SBP index, this step's (faded); empty: every SBP on its face
     Real inset_fade_ = 0;          // m (interpolate_surface)
+    Vec3 fade_lo_{0, 0, 0}, fade_hi_{0, 0, 0};  // the domain's faces the fade sees (none without walls)
     Real largest_inset_ = 0;       // m
     // Two-way coupling (coupling.hpp): this step's reaction per IBP and SBP slot, and the SBPs'
     // shares of each IBP.

@@ -4,7 +4,9 @@
 // (virtual_boundary.hpp) and interface tension (interface_tension.hpp, coupling.hpp) act at the
 // face itself.
 #pragma once
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "algorithms/vec3.hpp"
 
@@ -22,15 +24,53 @@ struct SbpFaces {
 // one fluid layer at rest density under a body resting on the floor, and a heavy body landing
 // on it is thrown back (docs/coupling.md). Faded out over that length, the face meets the wall
 // as a face lined with its SBPs does, and the film between is squeezed out. 0: no fade (no walls).
+// A static box's faces are met the same way (below).
 inline Real surface_inset_fade(bool walls, Real support_radius, Real wall_gap) {
     return walls ? support_radius + (wall_gap > Real(0) ? wall_gap : Real(0)) : Real(0);
 }
 
+// The same against the domain walls and the static boxes: h plus the widest of their layers' gaps
+// (0: neither).
+template <class Boxes>
+inline Real surface_inset_fade(bool walls, Real support_radius, Real wall_gap, const Boxes& boxes) {
+    Real gap = walls && wall_gap > Real(0) ? wall_gap : Real(0);
+    for (const auto& b : boxes) gap = b.layer_gap > gap ? b.layer_gap : gap;
+    return walls || !boxes.empty() ? support_radius + gap : Real(0);
+}
+
+// The domain's faces as the fade sees them: none without walls (a fade that only static boxes
+// need leaves the open domain's faces alone).
+inline void faces_to_fade_at(bool walls, Vec3 domain_min, Vec3 domain_max, Vec3& lo, Vec3& hi) {
+    const Real far = std::numeric_limits<Real>::max();
+    lo = walls ? domain_min : Vec3{-far, -far, -far};
+    hi = walls ? domain_max : Vec3{far, far, far};
+}
+
+// How far a face point lies from a static box's face [lo, hi] that its normal points at, when it
+// lies over that face (within the box's extent along the other two axes) and nearer than `gap`;
+// otherwise `gap`. Its top under a body resting on it is such a face, as the floor is.
+MW_INLINE Real facing_box_gap(Vec3 face, Vec3 normal, Vec3 lo, Vec3 hi, Real gap) {
+    const Real f[3] = {face.x, face.y, face.z}, n[3] = {normal.x, normal.y, normal.z};
+    const Real l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+    const Real half = Real(0.5);
+    for (int k = 0; k < 3; ++k) {
+        const int a = (k + 1) % 3, c = (k + 2) % 3;
+        if (f[a] < l[a] || f[a] > h[a] || f[c] < l[c] || f[c] > h[c]) continue;
+        if (n[k] < -half && f[k] >= h[k] && f[k] - h[k] < gap) gap = f[k] - h[k];
+        if (n[k] > half && f[k] <= l[k] && l[k] - f[k] < gap) gap = l[k] - f[k];
+    }
+    return gap;
+}
+
 // How far an SBP with rest inset `inset` sits inside its face this step: scaled down linearly as
 // its face point `face` comes within `fade` of a domain wall's face that its normal points at.
-MW_INLINE Real faded_inset(Real inset, Vec3 face, Vec3 normal, Vec3 lo, Vec3 hi, Real fade) {
+// And as it comes within `fade` of a static box's face it points at (`boxes`: anything with
+// size() and [k].lo, [k].hi).
+template <class Boxes>
+MW_INLINE Real faded_inset(Real inset, Vec3 face, Vec3 normal, Vec3 lo, Vec3 hi, Real fade, const Boxes& boxes) {
     if (!(inset > Real(0)) || !(fade > Real(0))) return inset;
     Real gap = fade;
+    for (std::size_t b = 0; b < boxes.size(); ++b) gap = facing_box_gap(face, normal, boxes[b].lo, boxes[b].hi, gap);
     const Real half = Real(0.5);
     if (normal.x < -half && face.x - lo.x < gap) gap = face.x - lo.x;
     if (normal.x > half && hi.x - face.x < gap) gap = hi.x - face.x;

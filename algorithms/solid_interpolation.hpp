@@ -13,6 +13,7 @@
 
 #include "algorithms/lsm_regions.hpp"
 #include "algorithms/solid_face.hpp"
+#include "algorithms/wall_contact.hpp"
 #include "backend/backend.hpp"
 
 MW_BACKEND_BEGIN
@@ -32,10 +33,11 @@ struct InterpolationData {
     const SbpLink* sbp = nullptr;
     Vec3* sbp_normal = nullptr;
     // Each SBP's inset this step (null: none set in), faded near the domain walls [wall_lo,
-    // wall_hi] over `inset_fade` (solid_face.hpp, faded_inset).
+    // wall_hi] and the static boxes over `inset_fade` (solid_face.hpp, faded_inset).
     Real* sbp_inset = nullptr;
     Vec3 wall_lo{0, 0, 0}, wall_hi{0, 0, 0};
     Real inset_fade = 0;
+    View<const ContactBox> boxes;  // the static boxes, faded near as the walls are
 };
 
 inline void interpolate_geometry(const DeviceContext& device, const InterpolationData d, Real dt) {
@@ -75,7 +77,7 @@ inline void interpolate_surface(const DeviceContext& device, const Interpolation
         const std::uint32_t i = d.store_of_slot[d.sbp_first + k];
         Real inset = link.inset;
         if (d.sbp_inset) {
-            inset = faded_inset(inset, x, normal, d.wall_lo, d.wall_hi, d.inset_fade);
+            inset = faded_inset(inset, x, normal, d.wall_lo, d.wall_hi, d.inset_fade, d.boxes);
             d.sbp_inset[k] = inset;
         }
         d.position[i] = x - inset * normal;

@@ -539,12 +539,14 @@ std::size_t add_solid_object(SimulationSetup& setup, const TriangleMesh& mesh, S
         if (!thin_elastic)
             for (std::size_t k = 0; k < inset.size(); ++k) inset[k] = std::min(depth, half_thickness[k]);
     }
-    // Where each step puts them (solid_face.hpp: faded near the domain walls).
+    // Where each step puts them (solid_face.hpp: faded near the domain walls and the static boxes).
     const BoundaryParams& walls = setup.params.boundary;
-    const Real fade = surface_inset_fade(walls.walls, setup.params.fluid.support_radius, walls.wall_gap);
+    const Real fade = surface_inset_fade(walls.walls, setup.params.fluid.support_radius, walls.wall_gap, walls.static_boxes);
+    Vec3 fade_lo, fade_hi;
+    faces_to_fade_at(walls.walls, setup.params.domain_min, setup.params.domain_max, fade_lo, fade_hi);
     for (std::size_t k = 0; k < sample.sbp.count(); ++k) {
         const Real faded = faded_inset(Real(inset[k]), to_vec3(sample.sbp.positions[k]), to_vec3(sample.sbp.normals[k]),
-                                       setup.params.domain_min, setup.params.domain_max, fade);
+                                       fade_lo, fade_hi, fade, walls.static_boxes);
         const Vec3d set_in = sample.sbp.positions[k] - double(faded) * sample.sbp.normals[k];
         solid.sbp.push_back(push(to_vec3(set_in), kSurfaceBoundary));
         solid.sbp_inset.push_back(Real(inset[k]));
