@@ -53,7 +53,8 @@ MW_INLINE bool fluid_within(const GridView& grid, View<const Vec3> position, Vec
 // mode: the relation is symmetric) or within h of it (lists, built every step with the same test):
 // `read_reach2` is h² with lists and any distance on the grid. Inside a large object, and before
 // the fluid arrives, that is most of its particles (tests/core/test_kernels.cpp checks the volumes
-// read are unchanged).
+// read are unchanged). Lists kept with a skin (pairs beyond h, for later steps) would need
+// `read_reach2` widened by the same skin.
 template <class Kernel>
 void compute_boundary_volumes(const DeviceContext& device, GridView grid, View<const Vec3> position, View<Real> volume, std::size_t first,
                               std::size_t count, bool moving, Kernel kernel, View<const std::int32_t> object = {},
