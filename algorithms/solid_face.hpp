@@ -23,14 +23,9 @@ struct SbpFaces {
 // walls' gap of the wall's face); set in all the way, the SBPs and the wall's layer would hold
 // one fluid layer at rest density under a body resting on the floor, and a heavy body landing
 // on it is thrown back (docs/coupling.md). Faded out over that length, the face meets the wall
-// as a face lined with its SBPs does, and the film between is squeezed out. 0: no fade (no walls).
-// A static box's faces are met the same way (below).
-inline Real surface_inset_fade(bool walls, Real support_radius, Real wall_gap) {
-    return walls ? support_radius + (wall_gap > Real(0) ? wall_gap : Real(0)) : Real(0);
-}
-
-// The same against the domain walls and the static boxes: h plus the widest of their layers' gaps
-// (0: neither).
+// as a face lined with its SBPs does, and the film between is squeezed out. A static box's faces
+// are met the same way (facing_box_gap). The fade: h plus the widest layer gap of the walls and
+// the boxes; 0 with neither.
 template <class Boxes>
 inline Real surface_inset_fade(bool walls, Real support_radius, Real wall_gap, const Boxes& boxes) {
     Real gap = walls && wall_gap > Real(0) ? wall_gap : Real(0);
