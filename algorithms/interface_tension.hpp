@@ -23,6 +23,7 @@
 
 #include "algorithms/boundary_volumes.hpp"
 #include "algorithms/fluid.hpp"
+#include "algorithms/melting_faces.hpp"
 #include "algorithms/module.hpp"
 #include "algorithms/particle_types.hpp"
 #include "algorithms/solid_bodies.hpp"
@@ -108,7 +109,7 @@ class InterfaceTension final : public Module {
         t.sbp_eta = solids_.sbp_eta();
         t.lattice_eta = solids_.lattice_eta();
         t.lattice_normal = solids_.lattice_normals();
-        t.lattice_inset = Real(0.5) * state_.params.fluid.spacing;
+        t.lattice_inset = lattice_face_offset(state_.params.fluid.spacing);
         t.faces = solids_.sbp_faces();
         t.ibp_count = static_cast<std::uint32_t>(solids_.ibp_count());
         add_interface_tension(state_.device, step.neighbors.grid, step.ranges.fluid_end, state_.store.position.cview(),

@@ -27,6 +27,11 @@
 
 MW_BACKEND_BEGIN
 
+// How far in front of a melting lattice's exposed vertex, along its normal, its cell's face lies:
+// half the spacing (the lattice's cells are r0 wide). The correction and interface tension meet the
+// vertex there.
+MW_INLINE Real lattice_face_offset(Real spacing) { return Real(0.5) * spacing; }
+
 // The correction's arrays for the melting lattices, by IBP slot (SolidBodies owns them).
 struct LatticeFaceArrays {
     Vec3* normal = nullptr;        // null: the correction does not meet the lattices

@@ -501,7 +501,7 @@ class SolidBodies final : public Module {
         if (!sbp_inverse_mass_.empty()) c.sbp_inverse_mass = sbp_inverse_mass_.view().data();
         if (lattice_faces_met_) c.lattice_normal = lattice_normal_.view().data();
         if (!lattice_inverse_mass_.empty()) c.lattice_inverse_mass = lattice_inverse_mass_.view().data();
-        c.lattice_inset = Real(0.5) * reach;
+        c.lattice_inset = lattice_face_offset(reach);
         c.ibp_count = static_cast<std::uint32_t>(ibp_count_);
         c.sbp_count = static_cast<std::uint32_t>(sbp_count_);
         c.band = band;

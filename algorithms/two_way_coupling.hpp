@@ -11,6 +11,7 @@
 #include "algorithms/boundary_volumes.hpp"
 #include "algorithms/coupling.hpp"
 #include "algorithms/fluid.hpp"
+#include "algorithms/melting_faces.hpp"
 #include "algorithms/module.hpp"
 #include "algorithms/solid_bodies.hpp"
 
@@ -168,7 +169,7 @@ class TwoWayCoupling final : public Module, public PressureResponse {
             coupling.answering_only = solids_.object_ibps().params;
         }
         coupling.inverse_dt = Real(1) / dt;
-        coupling.lattice_inset = Real(0.5) * state_.params.fluid.spacing;
+        coupling.lattice_inset = lattice_face_offset(state_.params.fluid.spacing);
         fluid_reaction_on_solids(state_.device, pairs(step), coupling, state_.store.position.cview(),
                                  state_.store.velocity.cview(), fluid_.predicted(), volumes_.volumes(),
                                  fluid_.pressure_term(), fluid, fluid_.has_viscosity() && fluid.wall_viscosity > Real(0));
