@@ -338,7 +338,7 @@ inline void relax_object_accelerations(const DeviceContext& device, ObjectIbps o
         target.linear = step.gravity + force / body.M;
         target.angular = motion.inverse_inertia * (torque - cross(motion.centre, force));
         // The walls: the object's expected shift dt (V + dt G) keeps its extent inside the box.
-        target.linear = bounded_by_walls(target.linear, motion.velocity, anchor + lo, anchor + hi, params.margin, step);
+        target.linear = bounded_by_walls(target.linear, motion.velocity, anchor + lo, anchor + hi, params.wall_margin, step);
         // Aitken over (linear, size × angular), one ω per object.
         const Real size = Real(0.5) * norm(hi - lo);
         const Vec3 r_linear = target.linear - now.linear, r_angular = size * (target.angular - now.angular);
@@ -475,7 +475,7 @@ inline void relax_node_accelerations(const DeviceContext& device, const NodeResp
             target = n.other[s] + n.fluid_acceleration[s];
             // The walls: the node's shift dt (v + dt a) stays inside the box shrunk by its margin.
             const std::uint32_t i = n.store_of_slot[s];
-            target = bounded_by_walls(target, velocity[i], position[i], position[i], params.margin, step);
+            target = bounded_by_walls(target, velocity[i], position[i], position[i], params.wall_margin, step);
         }
         n.target_residual[s] = target - accel[s];
     });

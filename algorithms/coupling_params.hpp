@@ -22,6 +22,10 @@ struct CouplingParams {
     // (sampling/surface_inset.hpp), so that the fluid rests at the face as it does at a wall; a
     // thin elastic object's stay on its faces (apps/scene_builder.cpp).
     bool surface_inset = true;
+    // In a scene with fluid, moving objects that start clear of them stop a fluid layer (1.5 r0)
+    // short of the domain walls and the static boxes instead of touching them (docs/contact.md,
+    // "The film"; algorithms/lsm_regions.hpp, object_keeps_wall_film).
+    bool wall_film = true;
 };
 
 inline const ParamTable<CouplingParams>& coupling_keys() {
@@ -40,6 +44,8 @@ inline const ParamTable<CouplingParams>& coupling_keys() {
                                    "rigid and elastic objects answer the fluid's pressure inside the PCISPH iterations (with predict_solids)"));
         t.push_back(boolean_key<T>("coupling", "surface_inset", member(&T::surface_inset),
                                    "rigid and elastic objects' surface particles sit inside the face by the walls' gap, so fluid rests at the face"));
+        t.push_back(boolean_key<T>("coupling", "wall_film", member(&T::wall_film),
+                                   "with fluid, moving objects stop a fluid layer (1.5 r0) short of the walls and static boxes, so fluid caught there is not squeezed"));
         return t;
     }();
     return table;

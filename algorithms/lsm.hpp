@@ -104,11 +104,12 @@ constexpr int kObstacleSweeps = 2;
 // An elastic IBP (or a cloth node) at the obstacles: out to the margin along the deepest contact's
 // normal, its velocity into the obstacle dropped and a share `friction` of its sliding removed,
 // as at a domain wall.
-MW_INLINE void keep_out_of_obstacles(const SolidObstacles& obstacles, Real margin, Real friction, Vec3& x, Vec3& v) {
+MW_INLINE void keep_out_of_obstacles(const SolidObstacles& obstacles, Real margin, Real object_margin, Real friction, Vec3& x,
+                                     Vec3& v) {
     for (int sweep = 0; sweep < kObstacleSweeps; ++sweep) {
         Vec3 n{0, 0, 0};
         Real depth = 0;
-        if (!obstacles.deepest(x, margin, n, depth)) return;
+        if (!obstacles.deepest(x, margin, object_margin, n, depth)) return;
         x += depth * n;
         const Real vn = dot(v, n);
         const Vec3 normal = vn < Real(0) ? Vec3{0, 0, 0} : vn * n;
@@ -281,11 +282,11 @@ inline void lsm_particle_update(const DeviceContext& device, const LsmData d, co
             d.velocity[i] = v;
             return;
         }
-        if (p.obstacles.any()) keep_out_of_obstacles(p.obstacles, obj.margin, obj.friction, x, v);
+        if (p.obstacles.any()) keep_out_of_obstacles(p.obstacles, obj.wall_margin, obj.margin, obj.friction, x, v);
         // Domain walls: clamp into the box shrunk by the margin, drop the outward normal velocity,
         // scale the tangential velocity by (1 - friction) on each wall touched.
-        const Real lo[3] = {p.domain_min.x + obj.margin, p.domain_min.y + obj.margin, p.domain_min.z + obj.margin};
-        const Real hi[3] = {p.domain_max.x - obj.margin, p.domain_max.y - obj.margin, p.domain_max.z - obj.margin};
+        const Real lo[3] = {p.domain_min.x + obj.wall_margin, p.domain_min.y + obj.wall_margin, p.domain_min.z + obj.wall_margin};
+        const Real hi[3] = {p.domain_max.x - obj.wall_margin, p.domain_max.y - obj.wall_margin, p.domain_max.z - obj.wall_margin};
         Real* xc[3] = {&x.x, &x.y, &x.z};
         Real* vc[3] = {&v.x, &v.y, &v.z};
         for (int a = 0; a < 3; ++a) {
@@ -372,8 +373,8 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
     parallel_for(device, "lsm_rigid_walls", object_count, [=] MW_HD(std::size_t o) {
         const LsmObjectParams obj = d.objects[o];
         if (!obj.rigid) return;
-        const Vec3 lo = p.domain_min + Vec3{obj.margin, obj.margin, obj.margin};
-        const Vec3 hi = p.domain_max - Vec3{obj.margin, obj.margin, obj.margin};
+        const Vec3 lo = p.domain_min + Vec3{obj.wall_margin, obj.wall_margin, obj.wall_margin};
+        const Vec3 hi = p.domain_max - Vec3{obj.wall_margin, obj.wall_margin, obj.wall_margin};
         // Walls 2a (the low face of axis a, normal +e_a) and 2a + 1 (the high face, normal -e_a):
         // how deep the deepest IBP is past each (0: none). The body's sums are taken relative to
         // an anchor IBP, so that float keeps the body's size, not its place.
@@ -396,7 +397,7 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
             }
             Vec3 n{0, 0, 0};
             Real obstacle_depth = 0;
-            touching = touching || p.obstacles.deepest(x, obj.margin, n, obstacle_depth);
+            touching = touching || p.obstacles.deepest(x, obj.wall_margin, obj.margin, n, obstacle_depth);
             body.add(d.mass[s], r, d.velocity[i]);
         }
         if (!touching || !(body.M > Real(0)) || !is_finite(body.momentum)) return;  // non-finite values are the guard's
@@ -438,7 +439,7 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
                 // Its deepest obstacle contact, the same way along that obstacle's normal.
                 Vec3 n{0, 0, 0};
                 Real depth = 0;
-                if (!p.obstacles.deepest(x, obj.margin, n, depth)) continue;
+                if (!p.obstacles.deepest(x, obj.wall_margin, obj.margin, n, depth)) continue;
                 const Real k = Real(1) / M + dot(n, cross(inverse_inertia * cross(r, n), r));
                 const Real before = obstacle_impulse[s];
                 const Real vn = dot(V + cross(omega, r), n);
@@ -468,7 +469,7 @@ inline void lsm_rigid_walls(const DeviceContext& device, const LsmData d, const 
                     if (i == kMeltedSlot) continue;
                     Vec3 n{0, 0, 0};
                     Real depth = 0;
-                    if (!p.obstacles.deepest(d.position[i], obj.margin, n, depth)) continue;
+                    if (!p.obstacles.deepest(d.position[i], obj.wall_margin, obj.margin, n, depth)) continue;
                     if (sweep == 0 && depth > deepest) deepest = depth, deepest_normal = n;
                     const Real need = depth - dot(shift, n);
                     if (need > Real(0)) shift += need * n;

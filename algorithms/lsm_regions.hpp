@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -50,7 +51,11 @@ struct LsmObjectParams {
     Real damping_rate = 0;  // 1/s, per region (lsm.damping)
     Real body_damping_rate = 0;  // 1/s, over the whole body (lsm.body_damping)
     Real friction = 0;      // wall friction
-    Real margin = 0;        // IBPs stay this far inside the domain walls
+    Real margin = 0;        // r0/2: its outer IBPs lie about this far inside its surface (contacts between objects)
+    // IBPs stay this far from the domain walls and the static boxes: the margin, and where the
+    // object keeps the walls' film (object_keeps_wall_film) kWallFilmLayers fluid spacings more,
+    // so that its surface stops a fluid layer short of them (docs/contact.md, "The film").
+    Real wall_margin = 0;
     std::uint8_t rigid = 0; // 1 for a rigid object (one region), 0 for an elastic one
     // 1 for a cloth or a rod: each node answers the fluid's pressure on its own inside PCISPH
     // (coupling.strong; coupling.hpp, relax_node_accelerations), and PCISPH meets each of its
@@ -433,6 +438,45 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
 
 // Builds the slot arrays and regions of every moving solid (elastic or rigid) of `setup`.
 // `serial_limit`: regions with more members are summed in chunks (a parameter for tests).
+// The walls' film (coupling.wall_film), in fluid spacings between an object's surface and a wall
+// or static solid it rests on: the fluid rests half a spacing from a wall's face and about one
+// spacing from an object's face lined with its surface particles (docs/contact.md, "The film").
+constexpr Real kWallFilmLayers = Real(1.5);
+
+// How close an object's IBPs start to the domain walls and the static boxes (the nearest one's
+// distance; infinite with neither). In 2D they have no faces normal to z.
+inline Real start_clearance(const SimulationSetup& setup, const SolidSetup& s) {
+    const BoundaryParams& b = setup.params.boundary;
+    const bool planar = setup.params.dimensions == 2;
+    const Vec3 lo = setup.params.domain_min, hi = setup.params.domain_max;
+    Real closest = std::numeric_limits<Real>::infinity();
+    for (std::uint32_t index : s.ibp) {
+        const Vec3 x = setup.position[index];
+        if (b.walls) {
+            closest = std::min({closest, x.x - lo.x, hi.x - x.x, x.y - lo.y, hi.y - x.y});
+            if (!planar) closest = std::min({closest, x.z - lo.z, hi.z - x.z});
+        }
+        for (const StaticBoxFaces& box : b.static_boxes) {
+            const Real dx = std::max({box.lo.x - x.x, Real(0), x.x - box.hi.x});
+            const Real dy = std::max({box.lo.y - x.y, Real(0), x.y - box.hi.y});
+            const Real dz = planar ? Real(0) : std::max({box.lo.z - x.z, Real(0), x.z - box.hi.z});
+            closest = std::min(closest, std::sqrt(dx * dx + dy * dy + dz * dz));
+        }
+    }
+    return closest;
+}
+
+// Whether an object keeps the walls' film (coupling.wall_film): in a scene with fluid, unless it
+// is pinned (anchored, it never lands) or starts closer to a wall or a static box than the film
+// would hold it (a box set on the floor stays where the scene puts it, touching). The static mesh
+// objects are met without it: their distance grids reach about 1.45 r0 past their surface
+// (scene_builder.cpp, add_static_object_distance), short of the film's 2 r0.
+inline bool object_keeps_wall_film(const SimulationSetup& setup, const SolidSetup& s, Real margin) {
+    if (!setup.keeps_wall_film()) return false;
+    if (std::any_of(s.pinned.begin(), s.pinned.end(), [](std::uint8_t p) { return p != 0; })) return false;
+    return start_clearance(setup, s) >= margin + kWallFilmLayers * setup.params.fluid.spacing;
+}
+
 inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t serial_limit = kRegionSerialMembers) {
     LsmHostLayout L;
     const std::size_t n_particles = setup.position.size();
@@ -494,6 +538,7 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         P.body_damping_rate = s.kind == SolidKind::kRigid ? Real(0) : s.body_damping;
         P.friction = s.wall_friction;
         P.margin = Real(0.5) * s.spacing;
+        P.wall_margin = P.margin + (object_keeps_wall_film(setup, s, P.margin) ? kWallFilmLayers * setup.params.fluid.spacing : Real(0));
         P.rigid = s.kind == SolidKind::kRigid ? 1 : 0;
         P.nodal = is_thin(s.kind) ? 1 : 0;
         P.body_answer = s.kind == SolidKind::kRigid || (s.kind == SolidKind::kElastic && !s.melts()) ? 1 : 0;

@@ -93,10 +93,10 @@ MW_INLINE bool pair_contact(const SolidCollisionData& c, Vec3 x, Real reach, std
 
 // The IBP at x against the walls and static obstacles: true, with the normal and the gap, when
 // it is a contact.
-MW_INLINE bool obstacle_contact(const SolidCollisionData& c, Vec3 x, Real margin, Vec3& n, Real& gap) {
-    const Real slop = Real(2 * kContactSlop) * margin;
+MW_INLINE bool obstacle_contact(const SolidCollisionData& c, Vec3 x, const LsmObjectParams& object, Vec3& n, Real& gap) {
+    const Real slop = Real(2 * kContactSlop) * object.margin;
     Real depth = 0;
-    if (!c.obstacles.deepest_with_walls(x, margin + slop, n, depth)) return false;
+    if (!c.obstacles.deepest_with_walls(x, object.wall_margin + slop, object.margin + slop, n, depth)) return false;
     gap = slop - depth;
     return true;
 }
@@ -129,7 +129,7 @@ inline std::uint64_t count_solid_contacts(const DeviceContext& device, const Sol
                 const std::int32_t t = other_ibp(c, j, object);
                 if (t >= 0 && pair_contact(c, x, margin + c.lsm.objects[c.lsm.object[t]].margin, j, n, gap)) ++count;
             });
-            if (obstacle_contact(c, x, margin, n, gap)) ++count;
+            if (obstacle_contact(c, x, c.lsm.objects[object], n, gap)) ++count;
         }
         c.contacts[s] = count;
     });
@@ -190,7 +190,7 @@ inline void gather_solid_impulses(const DeviceContext& device, const SolidCollis
                                              Real(0.5) * (own.friction + other.friction), dt, positions);
             });
             // The walls and static obstacles, infinitely heavy: the same rules with W_b = 0.
-            if (obstacle_contact(c, x, own.margin, n, gap)) {
+            if (obstacle_contact(c, x, own, n, gap)) {
                 const Real w = split_inverse_mass(c, s, i, n);
                 if (w > Real(0)) total += contact_impulse(v, n, gap, w, own.friction, dt, positions);
             }

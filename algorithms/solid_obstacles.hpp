@@ -1,7 +1,8 @@
 // What a moving solid's particles meet besides the domain walls: the static boxes and the static
 // mesh objects (docs/contact.md). An IBP is a contact when it lies closer than its object's margin
-// (r0/2, as at the domain walls: a lattice's outer IBPs lie about r0/2 inside its surface) to an
-// obstacle's surface, or inside it; its depth is how far it must move along the obstacle's
+// to an obstacle's surface, or inside it: r0/2 from a mesh object (a lattice's outer IBPs lie about
+// r0/2 inside its surface), and from a box as from the domain walls (r0/2, or 2 r0 where the object
+// keeps the walls' film: lsm_regions.hpp, wall_margin); its depth is how far it must move along the obstacle's
 // outward normal to lie at the margin. The geometry is the walls' correction's (wall_contact.hpp):
 // a box's faces (its first particle layer lies on them), a mesh object's signed distance grid.
 // lsm.hpp answers the contacts: IBP by IBP for an elastic object or cloth, as one body for a rigid
@@ -29,8 +30,8 @@ struct SolidObstacles {
     MW_INLINE bool any() const { return boxes.size() + objects.size() != 0; }
 
     // deepest() with the domain walls.
-    MW_INLINE bool deepest_with_walls(Vec3 x, Real margin, Vec3& n, Real& depth) const {
-        if (!deepest(x, margin, n, depth)) depth = Real(0);
+    MW_INLINE bool deepest_with_walls(Vec3 x, Real margin, Real object_margin, Vec3& n, Real& depth) const {
+        if (!deepest(x, margin, object_margin, n, depth)) depth = Real(0);
         if (!walls || !is_finite(x)) return depth > Real(0);
         const Real past[6] = {wall_lo.x + margin - x.x, x.x - (wall_hi.x - margin), wall_lo.y + margin - x.y,
                               x.y - (wall_hi.y - margin), wall_lo.z + margin - x.z, x.z - (wall_hi.z - margin)};
@@ -47,7 +48,7 @@ struct SolidObstacles {
     // its nearest face; inside a mesh object, along the distance's gradient (a flat gradient, in
     // a plate thinner than the grid resolves, gives no direction and no contact). Non-finite x:
     // none (the guard's).
-    MW_INLINE bool deepest(Vec3 x, Real margin, Vec3& n, Real& depth) const {
+    MW_INLINE bool deepest(Vec3 x, Real margin, Real object_margin, Vec3& n, Real& depth) const {
         if (!is_finite(x)) return false;
         depth = Real(0);
         for (std::size_t b = 0; b < boxes.size(); ++b) {
@@ -58,10 +59,10 @@ struct SolidObstacles {
         for (std::size_t o = 0; o < objects.size(); ++o) {
             Real distance = 0;
             Vec3 gradient{0, 0, 0};
-            if (!objects[o].field.sample(object_distances, x, distance, gradient) || !(distance < margin)) continue;
+            if (!objects[o].field.sample(object_distances, x, distance, gradient) || !(distance < object_margin)) continue;
             const Real g2 = norm2(gradient);
             if (!(g2 > Real(1e-6))) continue;
-            if (margin - distance > depth) depth = margin - distance, n = (Real(1) / std::sqrt(g2)) * gradient;
+            if (object_margin - distance > depth) depth = object_margin - distance, n = (Real(1) / std::sqrt(g2)) * gradient;
         }
         return depth > Real(0);
     }

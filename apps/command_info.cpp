@@ -332,6 +332,9 @@ void print_contact(const InfoFacts& f) {
                 : f.setup.params.solver.solid_contact
                     ? (" and one another, in " + std::to_string(kCollisionIterations) + " Jacobi sweeps a substep").c_str()
                     : ", not one another (solver.solid_contact false)");
+    if (f.setup.keeps_wall_film())
+        std::printf("            with fluid, those that start clear of them stop a fluid layer (1.5 r0) short of the walls and "
+                    "static boxes (coupling.wall_film)\n");
 }
 
 void print_emitters_and_heat(const InfoFacts& f) {

@@ -726,7 +726,7 @@ int main(int argc, char** argv) {
               << "| kind | coupling.strong | kg/m3 | CFL | end | steps | s | top fluid speed m/s | fastest IBP at the end m/s | cube's "
                  "centre height at the end m |\n|---|---|---|---|---|---|---|---|---|---|\n"
               << rows;
-            emit(t.str() + "\nOn the floor the cube's centre is at 0.06 m; floating, 0.25 m less its draft plus 0.06 m.\n\n");
+            emit(t.str() + "\nOn the floor the cube's centre is at 0.06 m, on the walls' film (coupling.wall_film) 0.09 m; floating, 0.25 m less its draft plus 0.06 m.\n\n");
             // A flat body landing flat: the same pool, a box 0.24 x 0.08 x 0.24 m let go from rest
             // under water, its broad face down, onto the film over the floor (docs/validation.md,
             // "A flat body landing flat").
@@ -757,7 +757,7 @@ int main(int argc, char** argv) {
               << "| kind | coupling.strong | kg/m3 | CFL | end | steps | s | top fluid speed m/s | fastest IBP at the end m/s | box's "
                  "centre height at the end m |\n|---|---|---|---|---|---|---|---|---|---|\n"
               << flat_rows;
-            emit(f.str() + "\nOn the floor the box's centre is at 0.04 m; on a film of one fluid layer, 0.06 m.\n\n");
+            emit(f.str() + "\nOn the floor the box's centre is at 0.04 m, on the walls' film (coupling.wall_film) 0.07 m.\n\n");
         }
         // The largest steps (scenes/thrown_cube.json): each case of the extremes at rising CFL
         // numbers, judged as tests/core/test_extremes.cpp judges its cases (ran to the end, nothing
@@ -848,7 +848,9 @@ int main(int argc, char** argv) {
                                             break;
                                         }
                             const StepReport& last = sim->last_report();
-                            const double floor_centre = double(cube.density) > fp.rest_density ? 0.06 : centre;
+                            // On the floor: half the cube's 0.12 m, plus the walls' film (coupling.wall_film, 1.5 r0).
+                            const double film = setup.params.coupling.wall_film ? 1.5 * r0 : 0.0;
+                            const double floor_centre = double(cube.density) > fp.rest_density ? 0.06 + film : centre;
                             char why[160] = "";
                             if (last.lost_particles > 0) std::snprintf(why, sizeof why, "%ld lost", last.lost_particles);
                             else if (inside > 0) std::snprintf(why, sizeof why, "%ld fluid inside", inside);
@@ -878,7 +880,7 @@ int main(int argc, char** argv) {
                  " s)\n\n| kind | kg/m3 | holds up to CFL (steps capped at 30 ms) | the first CFL that fails | holds up to the fixed step | "
                  "the first fixed step that fails |\n|---|---|---|---|---|---|\n" +
                  rows + "\nA case holds when it runs to the end with nothing lost, no fluid inside the cube, no energy gained, the cube at rest and, "
-                        "heavier than water, on the floor; each column stops at the first setting that fails.\n\n");
+                        "heavier than water, on the floor (on the walls' film where coupling.wall_film keeps it); each column stops at the first setting that fails.\n\n");
         }
         // Heat conduction (scenes/warm_jelly.json): the stage's cost against the step's, as the
         // Fourier number, and with it the explicit sub-steps (algorithms/heat.hpp), grows.

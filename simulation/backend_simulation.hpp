@@ -145,8 +145,7 @@ BackendSimulation<Kernel>::BackendSimulation(const SimulationSetup& setup, int t
     const std::vector<std::uint32_t> order = load_particles(setup, lo, hi);
     set_fluid_constants();
     // A scene whose objects melt, or with an emitter, gains fluid: its fluid stages run from the start.
-    state_.has_fluid = state_.counts.by_type[kFluid] > 0 || !setup.emitters.empty() ||
-                       std::any_of(setup.solids.begin(), setup.solids.end(), [](const SolidSetup& s) { return s.melts(); });
+    state_.has_fluid = setup.has_fluid();
     build_modules(setup, order, lo, hi);
     for (const auto& m : modules_) m->bind(plan_);
     plan_.finish();

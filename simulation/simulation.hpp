@@ -116,6 +116,20 @@ struct SimulationSetup {
     // empty otherwise.
     std::vector<Real> temperature;
 
+    // Whether the scene holds fluid or will: fluid particles, an emitter's pending ones, or an
+    // object that melts.
+    bool has_fluid() const {
+        for (std::uint8_t t : type)
+            if (t == kFluid || t == kPending) return true;
+        if (!emitters.empty()) return true;
+        for (const SolidSetup& s : solids)
+            if (s.melts()) return true;
+        return false;
+    }
+    // Whether moving objects stop a fluid layer short of the walls and static boxes
+    // (coupling.wall_film, in a scene with fluid; algorithms/lsm_regions.hpp, object_keeps_wall_film).
+    bool keeps_wall_film() const { return params.coupling.wall_film && has_fluid(); }
+
     // Whether any moving object's SBP sits inside its face (SolidSetup::sbp_inset): the
     // correction's band is then the narrower one (algorithms/wall_contact.hpp).
     bool any_sbp_set_in() const {
