@@ -51,7 +51,7 @@ struct LsmObjectParams {
     Real damping_rate = 0;  // 1/s, per region (lsm.damping)
     Real body_damping_rate = 0;  // 1/s, over the whole body (lsm.body_damping)
     Real friction = 0;      // wall friction
-    Real margin = 0;        // r0/2: its outer IBPs lie about this far inside its surface (contacts between objects)
+    Real margin = 0;        // r0/2, how far inside its surface its outer IBPs lie (contacts between objects)
     // IBPs stay this far from the domain walls and the static boxes: the margin, and where the
     // object keeps the walls' film (object_keeps_wall_film) kWallFilmLayers fluid spacings more,
     // so that its surface stops a fluid layer short of them (docs/contact.md, "The film").
@@ -436,10 +436,8 @@ inline void add_mesh_links(LsmHostLayout& L, const SimulationSetup& setup, const
 
 }  // namespace lsm_detail
 
-// Builds the slot arrays and regions of every moving solid (elastic or rigid) of `setup`.
-// `serial_limit`: regions with more members are summed in chunks (a parameter for tests).
 // The walls' film (coupling.wall_film), in fluid spacings between an object's surface and a wall
-// or static solid it rests on: the fluid rests half a spacing from a wall's face and about one
+// or static box it rests on: the fluid rests half a spacing from a wall's face and about one
 // spacing from an object's face lined with its surface particles (docs/contact.md, "The film").
 constexpr Real kWallFilmLayers = Real(1.5);
 
@@ -477,6 +475,8 @@ inline bool object_keeps_wall_film(const SimulationSetup& setup, const SolidSetu
     return start_clearance(setup, s) >= margin + kWallFilmLayers * setup.params.fluid.spacing;
 }
 
+// Builds the slot arrays and regions of every moving solid (elastic or rigid) of `setup`.
+// `serial_limit`: regions with more members are summed in chunks (a parameter for tests).
 inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t serial_limit = kRegionSerialMembers) {
     LsmHostLayout L;
     const std::size_t n_particles = setup.position.size();
@@ -538,7 +538,8 @@ inline LsmHostLayout build_lsm_layout(const SimulationSetup& setup, std::size_t 
         P.body_damping_rate = s.kind == SolidKind::kRigid ? Real(0) : s.body_damping;
         P.friction = s.wall_friction;
         P.margin = Real(0.5) * s.spacing;
-        P.wall_margin = P.margin + (object_keeps_wall_film(setup, s, P.margin) ? kWallFilmLayers * setup.params.fluid.spacing : Real(0));
+        const bool film = object_keeps_wall_film(setup, s, P.margin);
+        P.wall_margin = P.margin + (film ? kWallFilmLayers * setup.params.fluid.spacing : Real(0));
         P.rigid = s.kind == SolidKind::kRigid ? 1 : 0;
         P.nodal = is_thin(s.kind) ? 1 : 0;
         P.body_answer = s.kind == SolidKind::kRigid || (s.kind == SolidKind::kElastic && !s.melts()) ? 1 : 0;

@@ -1,9 +1,9 @@
 // What a moving solid's particles meet besides the domain walls: the static boxes and the static
 // mesh objects (docs/contact.md). An IBP is a contact when it lies closer than its object's margin
 // to an obstacle's surface, or inside it: r0/2 from a mesh object (a lattice's outer IBPs lie about
-// r0/2 inside its surface), and from a box as from the domain walls (r0/2, or 2 r0 where the object
-// keeps the walls' film: lsm_regions.hpp, wall_margin); its depth is how far it must move along the obstacle's
-// outward normal to lie at the margin. The geometry is the walls' correction's (wall_contact.hpp):
+// r0/2 inside its surface), and from a box as from the domain walls (r0/2, or 2 r0 where the
+// object keeps the walls' film: lsm_regions.hpp, wall_margin); its depth is how far it must move
+// along the obstacle's outward normal to lie at the margin. The geometry is the walls' correction's (wall_contact.hpp):
 // a box's faces (its first particle layer lies on them), a mesh object's signed distance grid.
 // lsm.hpp answers the contacts: IBP by IBP for an elastic object or cloth, as one body for a rigid
 // object.
@@ -29,7 +29,7 @@ struct SolidObstacles {
 
     MW_INLINE bool any() const { return boxes.size() + objects.size() != 0; }
 
-    // deepest() with the domain walls.
+    // deepest() with the domain walls, met at `margin` as the boxes are.
     MW_INLINE bool deepest_with_walls(Vec3 x, Real margin, Real object_margin, Vec3& n, Real& depth) const {
         if (!deepest(x, margin, object_margin, n, depth)) depth = Real(0);
         if (!walls || !is_finite(x)) return depth > Real(0);
@@ -43,8 +43,9 @@ struct SolidObstacles {
         return depth > Real(0);
     }
 
-    // The deepest contact of a particle at x kept `margin` off every obstacle: true, with the unit
-    // outward normal n and depth > 0, when there is one. A particle inside a box leaves through
+    // The deepest contact of a particle at x kept `margin` off every static box and
+    // `object_margin` off every mesh object: true, with the unit outward normal n and depth > 0,
+    // when there is one. A particle inside a box leaves through
     // its nearest face; inside a mesh object, along the distance's gradient (a flat gradient, in
     // a plate thinner than the grid resolves, gives no direction and no contact). Non-finite x:
     // none (the guard's).
