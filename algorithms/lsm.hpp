@@ -357,8 +357,8 @@ MW_INLINE Vec3 axis_vector(int axis, Real length) {
 }
 
 // A rigid object at the domain walls, as one body (after lsm_particle_update; one thread per
-// object, its IBPs in slot order: deterministic). Every IBP past a wall (past the margin r0/2, as
-// for elastic objects) is a contact. Through the body's mass and inertia, inelastic impulses at
+// object, its IBPs in slot order: deterministic). Every IBP past a wall (past its wall margin, as
+// for elastic objects: r0/2, or 2 r0 with the walls' film) is a contact. Through the body's mass and inertia, inelastic impulses at
 // the contacts take the body's velocity into the walls there to zero, so a box landing on a
 // corner turns down onto a face and rests on all of it; friction takes a share `friction` of the
 // body's sliding along each wall touched (as an elastic object's IBPs lose theirs). Then the
